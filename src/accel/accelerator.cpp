@@ -1,0 +1,49 @@
+#include "accel/accelerator.hpp"
+
+#include <chrono>
+
+#include "scene/errors.hpp"
+
+namespace tracer {
+
+static_assert(RayAccelerator<BruteForce>);
+static_assert(RayAccelerator<Bvh>);
+
+bool embree_available() {
+#ifdef TRACER_HAVE_EMBREE
+  return true;
+#else
+  return false;
+#endif
+}
+
+size_t Accelerator::memory_bytes() const {
+  return visit([](const auto& a) { return a.memory_bytes(); });
+}
+
+Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
+  Accelerator acc;
+  const auto start = std::chrono::steady_clock::now();
+  switch (options.kind) {
+    case AccelKind::Brute:
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<BruteForce>, scene);
+      acc.name = "brute";
+      break;
+    case AccelKind::Bvh:
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);
+      acc.name = options.bvh.split == BvhSplit::Sah ? "bvh-sah" : "bvh-median";
+      break;
+    case AccelKind::Embree:
+#ifdef TRACER_HAVE_EMBREE
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene);
+      acc.name = "embree";
+      break;
+#else
+      throw UsageError("--accel embree: this build has no Embree (configure with -DTRACER_EMBREE=ON)");
+#endif
+  }
+  acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return acc;
+}
+
+}  // namespace tracer

@@ -1,0 +1,55 @@
+// The interchangeable accelerators behind one interface: every alternative has
+//   bool intersect(const Ray&, Hit&) const;   // closest hit in [tnear, tfar]
+//   bool occluded(const Ray&) const;          // any hit in [tnear, tfar]
+// Callers dispatch on the variant once (per tile or per batch), never per ray.
+#pragma once
+
+#include <concepts>
+#include <memory>
+#include <string>
+#include <variant>
+
+#include "accel/brute_force.hpp"
+#include "accel/bvh.hpp"
+#ifdef TRACER_HAVE_EMBREE
+#include "accel/embree_accel.hpp"
+#endif
+
+namespace tracer {
+
+template <class A>
+concept RayAccelerator = requires(const A& a, const Ray& r, Hit& h) {
+  { a.intersect(r, h) } -> std::same_as<bool>;
+  { a.occluded(r) } -> std::same_as<bool>;
+};
+
+enum class AccelKind { Brute, Bvh, Embree };
+
+struct AccelOptions {
+  AccelKind kind = AccelKind::Bvh;
+  BvhBuildOptions bvh;
+};
+
+using AccelVariant = std::variant<BruteForce, Bvh
+#ifdef TRACER_HAVE_EMBREE
+                                  , EmbreeAccel
+#endif
+                                  >;
+
+struct Accelerator {
+  std::unique_ptr<AccelVariant> impl;  // heap: Embree's handle and the BVH must not move mid-render
+  double build_ms = 0.0;
+  std::string name;
+
+  template <class F>
+  decltype(auto) visit(F&& f) const { return std::visit(std::forward<F>(f), *impl); }
+  size_t memory_bytes() const;
+};
+
+bool embree_available();
+
+// Builds the accelerator `options` asks for, timing the build. Throws UsageError if it is not
+// compiled in (Embree).
+Accelerator build_accelerator(const Scene& scene, const AccelOptions& options);
+
+}  // namespace tracer

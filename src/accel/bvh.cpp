@@ -1,0 +1,169 @@
+// BVH traversal, statistics and validation. The build is in bvh_builder.cpp.
+#include "accel/bvh.hpp"
+
+#include <sstream>
+
+namespace tracer {
+
+bool Bvh::intersect(const Ray& ray, Hit& hit) const {
+  hit = Hit{};
+  hit.t = ray.tfar;
+  if (nodes_.empty()) return false;
+  const RayShear shear(ray);
+  const RayBoxTest box(ray);
+  if (box.enter(nodes_[0].lo, nodes_[0].hi, ray.tnear, hit.t) == kInfinity) return false;
+
+  struct Entry { uint32_t node; float t; };
+  Entry stack[kMaxDepth + 2];
+  int sp = 0;
+  uint32_t current = 0;
+  for (;;) {
+    const BvhNode& node = nodes_[current];
+    if (node.leaf()) {
+      for (uint32_t i = node.index, end = node.index + node.count; i < end; ++i) {
+        TriangleHit th;
+        if (intersect_triangle(shear, tris_[i], ray.tnear, hit.t, th) && closer(th.t, ids_[i], hit)) {
+          hit.t = th.t;
+          hit.u = th.u;
+          hit.v = th.v;
+          hit.tri = ids_[i];
+        }
+      }
+    } else {
+      const BvhNode& a = nodes_[node.index];
+      const BvhNode& b = nodes_[node.index + 1];
+      float ta = box.enter(a.lo, a.hi, ray.tnear, hit.t);
+      float tb = box.enter(b.lo, b.hi, ray.tnear, hit.t);
+      uint32_t near = node.index, far = node.index + 1;
+      if (tb < ta) {
+        std::swap(ta, tb);
+        std::swap(near, far);
+      }
+      if (ta != kInfinity) {
+        if (tb != kInfinity) stack[sp++] = {far, tb};
+        current = near;
+        continue;
+      }
+    }
+    // Pop, skipping nodes whose entry is now beyond the closest hit (<=: ties still count).
+    for (;;) {
+      if (sp == 0) goto done;
+      const Entry e = stack[--sp];
+      if (e.t <= hit.t) {
+        current = e.node;
+        break;
+      }
+    }
+  }
+done:
+  if (!hit.valid()) return false;
+  hit.geomID = scene_->tri_geom[hit.tri];
+  hit.primID = scene_->tri_prim[hit.tri];
+  return true;
+}
+
+bool Bvh::occluded(const Ray& ray) const {
+  if (nodes_.empty()) return false;
+  const RayShear shear(ray);
+  const RayBoxTest box(ray);
+  uint32_t stack[kMaxDepth + 2];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const BvhNode& node = nodes_[stack[--sp]];
+    if (box.enter(node.lo, node.hi, ray.tnear, ray.tfar) == kInfinity) continue;
+    if (node.leaf()) {
+      TriangleHit th;
+      for (uint32_t i = node.index, end = node.index + node.count; i < end; ++i) {
+        if (intersect_triangle(shear, tris_[i], ray.tnear, ray.tfar, th)) return true;
+      }
+    } else {
+      // Any hit ends the query, so order matters less; still visit the child nearer the origin
+      // along the ray first (the one on the ray's side of the split), pushed last.
+      const BvhNode& a = nodes_[node.index];
+      const BvhNode& b = nodes_[node.index + 1];
+      const int axis = max_dimension(abs(ray.dir));
+      const bool a_first = (a.lo[axis] + a.hi[axis] < b.lo[axis] + b.hi[axis]) == (ray.dir[axis] >= 0.0f);
+      stack[sp++] = a_first ? node.index + 1 : node.index;
+      stack[sp++] = a_first ? node.index : node.index + 1;
+    }
+  }
+  return false;
+}
+
+BvhStats Bvh::stats() const {
+  BvhStats s;
+  s.nodes = nodes_.size();
+  if (nodes_.empty()) return s;
+  const double root_area = std::max(1e-30f, Aabb{nodes_[0].lo, nodes_[0].hi}.half_area());
+  struct Item { uint32_t node; size_t depth; };
+  std::vector<Item> stack{{0, 1}};
+  size_t leaf_tris = 0;
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const BvhNode& n = nodes_[it.node];
+    s.max_depth = std::max(s.max_depth, it.depth);
+    const double rel_area = Aabb{n.lo, n.hi}.half_area() / root_area;
+    if (n.leaf()) {
+      ++s.leaves;
+      leaf_tris += n.count;
+      s.max_leaf_size = std::max<size_t>(s.max_leaf_size, n.count);
+      s.sah_cost += rel_area * n.count * options_.intersection_cost;
+    } else {
+      s.sah_cost += rel_area * options_.traversal_cost;
+      stack.push_back({n.index, it.depth + 1});
+      stack.push_back({n.index + 1, it.depth + 1});
+    }
+  }
+  s.avg_leaf_size = s.leaves ? double(leaf_tris) / double(s.leaves) : 0.0;
+  return s;
+}
+
+std::string Bvh::validate() const {
+  std::ostringstream err;
+  if (nodes_.empty()) return tris_.empty() ? "" : "triangles but no nodes";
+  std::vector<uint32_t> seen(scene_->size(), 0);
+  struct Item { uint32_t node; size_t depth; };
+  std::vector<Item> stack{{0, 1}};
+  std::vector<uint32_t> visits(nodes_.size(), 0);
+  const size_t leaf_limit = options_.split == BvhSplit::Median ? 2 : size_t(options_.max_leaf);
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    if (it.node >= nodes_.size()) return "node index out of range";
+    if (++visits[it.node] > 1) return "node " + std::to_string(it.node) + " reached twice";
+    if (it.depth > size_t(kMaxDepth)) return "depth exceeds kMaxDepth";
+    const BvhNode& n = nodes_[it.node];
+    const Aabb box{n.lo, n.hi};
+    if (n.leaf()) {
+      if (n.count > leaf_limit) return "leaf " + std::to_string(it.node) + " holds " + std::to_string(n.count) + " triangles";
+      if (size_t(n.index) + n.count > tris_.size()) return "leaf range out of bounds";
+      for (uint32_t i = n.index; i < n.index + n.count; ++i) {
+        if (!box.contains(tris_[i].bounds())) return "leaf " + std::to_string(it.node) + " box does not contain triangle " + std::to_string(ids_[i]);
+        if (ids_[i] >= seen.size()) return "triangle id out of range";
+        ++seen[ids_[i]];
+        if (!(scene_->triangles[ids_[i]].v0 == tris_[i].v0)) return "reordered triangle differs from scene";
+      }
+    } else {
+      if (size_t(n.index) + 1 >= nodes_.size()) return "child index out of range";
+      for (uint32_t c = n.index; c <= n.index + 1; ++c) {
+        if (!box.contains(Aabb{nodes_[c].lo, nodes_[c].hi})) return "node " + std::to_string(it.node) + " does not contain child " + std::to_string(c);
+        stack.push_back({c, it.depth + 1});
+      }
+    }
+  }
+  for (size_t i = 0; i < seen.size(); ++i) {
+    const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
+    if (seen[i] != expected) {
+      err << "triangle " << i << " appears in " << seen[i] << " leaves, expected " << expected;
+      return err.str();
+    }
+  }
+  for (size_t i = 0; i < visits.size(); ++i) {
+    if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
+  }
+  return "";
+}
+
+}  // namespace tracer

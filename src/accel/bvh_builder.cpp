@@ -1,0 +1,392 @@
+// BVH construction: the study's median split and a binned SAH, each built sequentially or in
+// parallel (std::async fork-join, a mutex-guarded job queue, or oneTBB tasks).
+//
+// Determinism: every split decision is a pure function of the primitive range it is given, and
+// the partitions are stable, so all builders produce the same tree. Nodes are first written into
+// a scratch array in whatever order threads reach them, then flattened depth-first, which fixes
+// the final layout independently of scheduling.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <condition_variable>
+#include <deque>
+#include <future>
+#include <mutex>
+#include <thread>
+
+#include "accel/bvh.hpp"
+
+namespace tracer {
+namespace {
+
+constexpr uint32_t kNone = 0xffffffffu;
+constexpr uint32_t kParallelSubtree = 4096;   // below this a subtree is built by one thread
+constexpr uint32_t kParallelSplit = 65536;    // above this one node's passes run in parallel (tasks)
+constexpr uint32_t kPartitionBlock = 16384;   // block size of the parallel stable partition
+constexpr uint32_t kMedianFallbackDepth = 64; // SAH switches to object median below this depth
+constexpr int kMaxBins = 64;
+
+struct BuildNode {
+  Aabb box;
+  uint32_t begin = 0, end = 0;
+  uint32_t left = kNone;  // children at left and left+1, or kNone for a leaf
+  uint32_t depth = 0;
+};
+
+struct Bin {
+  Aabb box;
+  uint32_t count = 0;
+};
+
+struct Bounds2 {
+  Aabb box, centroids;
+  void join(const Bounds2& o) {
+    box.extend(o.box);
+    centroids.extend(o.centroids);
+  }
+};
+
+int resolve_threads(int threads) {
+  return threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+class BvhBuilder {
+ public:
+  BvhBuilder(const Scene& scene, const BvhBuildOptions& options) : options_(options) {
+    options_.bins = std::clamp(options_.bins, 2, kMaxBins);
+    options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
+    for (uint32_t i = 0; i < scene.size(); ++i) {
+      if (!scene.triangles[i].degenerate()) prims_.push_back(i);
+    }
+    boxes_.resize(scene.size());
+    centroids_.resize(scene.size());
+    for (uint32_t i : prims_) {
+      boxes_[i] = scene.triangles[i].bounds();
+      centroids_[i] = boxes_[i].center();  // box centre, not vertex mean: it is what binning sees
+    }
+    scratch_.resize(prims_.size());
+    nodes_.resize(std::max<size_t>(1, 2 * prims_.size()));
+  }
+
+  void build() {
+    if (prims_.empty()) return;
+    nodes_[0] = BuildNode{{}, 0, uint32_t(prims_.size()), kNone, 0};
+    node_count_ = 1;
+    const int threads = resolve_threads(options_.threads);
+    switch (options_.mode) {
+      case BuildMode::Seq: build_seq(0); break;
+      case BuildMode::Async: build_async(0, async_depth_limit(threads)); break;
+      case BuildMode::Queue: build_queue(threads); break;
+      case BuildMode::Tasks: {
+        tbb::task_arena arena(threads);
+        arena.execute([&] { build_tasks(0); });
+        break;
+      }
+    }
+  }
+
+  // Depth-first flattening into the final layout: children adjacent, leaves pointing into prims_.
+  void flatten(std::vector<BvhNode>& out) const {
+    out.clear();
+    if (prims_.empty()) return;
+    out.reserve(node_count_.load());
+    out.push_back({});
+    struct Item { uint32_t build, flat; };
+    std::vector<Item> stack{{0, 0}};
+    while (!stack.empty()) {
+      const Item it = stack.back();
+      stack.pop_back();
+      const BuildNode& n = nodes_[it.build];
+      BvhNode& f = out[it.flat];
+      f.lo = n.box.lo;
+      f.hi = n.box.hi;
+      if (n.left == kNone) {
+        f.index = n.begin;
+        f.count = n.end - n.begin;
+      } else {
+        const auto first = static_cast<uint32_t>(out.size());
+        f.index = first;
+        f.count = 0;
+        out.push_back({});
+        out.push_back({});
+        // Push right first so the left subtree is laid out right after its parent.
+        stack.push_back({n.left + 1, first + 1});
+        stack.push_back({n.left, first});
+      }
+    }
+  }
+
+  const std::vector<uint32_t>& prims() const { return prims_; }
+
+ private:
+  static int async_depth_limit(int threads) {
+    // Enough forks to give every thread a subtree, plus one level for balance.
+    return std::bit_width(static_cast<unsigned>(threads)) + 1;
+  }
+
+  void build_seq(uint32_t id) {
+    if (!split(id, false)) return;
+    const uint32_t left = nodes_[id].left;
+    build_seq(left);
+    build_seq(left + 1);
+  }
+
+  // The study's v1: one std::async per recursive call, but only near the root and for large
+  // subtrees, so it never starts a thread per node.
+  void build_async(uint32_t id, int depth_left) {
+    if (!split(id, false)) return;
+    const uint32_t left = nodes_[id].left;
+    const BuildNode& l = nodes_[left];
+    if (depth_left > 0 && l.end - l.begin >= kParallelSubtree) {
+      auto right = std::async(std::launch::async, [this, left, depth_left] { build_async(left + 1, depth_left - 1); });
+      build_async(left, depth_left - 1);
+      right.get();
+    } else {
+      build_seq(left);
+      build_seq(left + 1);
+    }
+  }
+
+  // The study's v2: workers take node jobs from a shared FIFO. The lock covers only push/pop;
+  // idle workers sleep on a condition variable until a job arrives or every job has finished.
+  void build_queue(int threads) {
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<uint32_t> jobs{0};
+    size_t unfinished = 1;  // queued or running
+    const auto worker = [&] {
+      for (;;) {
+        uint32_t id;
+        {
+          std::unique_lock lock(mutex);
+          cv.wait(lock, [&] { return !jobs.empty() || unfinished == 0; });
+          if (jobs.empty()) return;
+          id = jobs.front();
+          jobs.pop_front();
+        }
+        const BuildNode& n = nodes_[id];
+        if (n.end - n.begin < kParallelSubtree) {
+          build_seq(id);
+        } else if (split(id, false)) {
+          const uint32_t left = nodes_[id].left;
+          std::lock_guard lock(mutex);
+          jobs.push_back(left);
+          jobs.push_back(left + 1);
+          unfinished += 2;
+          cv.notify_all();
+        }
+        std::lock_guard lock(mutex);
+        if (--unfinished == 0) cv.notify_all();
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
+    for (std::thread& t : pool) t.join();
+  }
+
+  // oneTBB: fork-join over subtrees, and data-parallel bounds, binning and partitioning for the
+  // few large nodes near the root, where there are too few subtrees to go round.
+  void build_tasks(uint32_t id) {
+    const BuildNode& n = nodes_[id];
+    const uint32_t size = n.end - n.begin;
+    if (size < kParallelSubtree) {
+      build_seq(id);
+      return;
+    }
+    if (!split(id, size >= kParallelSplit)) return;
+    const uint32_t left = nodes_[id].left;
+    tbb::parallel_invoke([&] { build_tasks(left); }, [&] { build_tasks(left + 1); });
+  }
+
+  template <class Body, class T>
+  T reduce_range(uint32_t begin, uint32_t end, bool parallel, T init, const Body& body) const {
+    if (!parallel) return body(begin, end, init);
+    return tbb::parallel_reduce(
+        tbb::blocked_range<uint32_t>(begin, end, kPartitionBlock), init,
+        [&](const tbb::blocked_range<uint32_t>& r, T acc) { return body(r.begin(), r.end(), acc); },
+        [](T a, const T& b) { a.join(b); return a; });
+  }
+
+  // Decides node `id`: a leaf (false) or two children appended to nodes_ (true).
+  bool split(uint32_t id, bool parallel) {
+    BuildNode& node = nodes_[id];
+    const uint32_t begin = node.begin, end = node.end, count = end - begin;
+    const Bounds2 bounds = reduce_range(begin, end, parallel, Bounds2{}, [&](uint32_t b, uint32_t e, Bounds2 acc) {
+      for (uint32_t i = b; i < e; ++i) {
+        acc.box.extend(boxes_[prims_[i]]);
+        acc.centroids.extend(centroids_[prims_[i]]);
+      }
+      return acc;
+    });
+    node.box = bounds.box;
+    uint32_t mid;
+    if (options_.split == BvhSplit::Median) {
+      if (count <= 2) return false;  // the study's leaves of one or two triangles
+      mid = median_split(begin, end, static_cast<int>(node.depth % 3));
+    } else {
+      if (count <= 1) return false;
+      const Vec3 extent = bounds.centroids.extent();
+      if (node.depth >= kMedianFallbackDepth || max_component(extent) <= 0.0f) {
+        // Nothing to bin (all centroids equal) or pathologically deep: halve by count.
+        if (count <= uint32_t(options_.max_leaf) && max_component(extent) <= 0.0f) return false;
+        mid = median_split(begin, end, max_dimension(extent));
+      } else {
+        const auto sah = sah_split(node, bounds.centroids, parallel);
+        if (sah.axis < 0) {
+          if (count <= uint32_t(options_.max_leaf)) return false;
+          mid = median_split(begin, end, max_dimension(extent));
+        } else {
+          const float leaf_cost = options_.intersection_cost * float(count);
+          if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
+          mid = partition(begin, end, parallel, [&](uint32_t prim) {
+            return bin_of(centroids_[prim][sah.axis], bounds.centroids, sah.axis) < sah.split_bin;
+          });
+        }
+      }
+    }
+    const uint32_t left = node_count_.fetch_add(2, std::memory_order_relaxed);
+    nodes_[left] = BuildNode{{}, begin, mid, kNone, node.depth + 1};
+    nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
+    node.left = left;
+    return true;
+  }
+
+  uint32_t median_split(uint32_t begin, uint32_t end, int axis) {
+    const uint32_t mid = begin + (end - begin) / 2;
+    // Ties broken by triangle index so the order is fully defined.
+    std::nth_element(prims_.begin() + begin, prims_.begin() + mid, prims_.begin() + end, [&](uint32_t a, uint32_t b) {
+      const float ca = centroids_[a][axis], cb = centroids_[b][axis];
+      return ca < cb || (ca == cb && a < b);
+    });
+    return mid;
+  }
+
+  int bin_of(float c, const Aabb& cbox, int axis) const {
+    const float scale = float(options_.bins) / (cbox.hi[axis] - cbox.lo[axis]);
+    const int b = static_cast<int>((c - cbox.lo[axis]) * scale);
+    return std::clamp(b, 0, options_.bins - 1);
+  }
+
+  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; };
+
+  struct BinSet {
+    Bin bins[3][kMaxBins];
+    void join(const BinSet& o) {
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < kMaxBins; ++b) {
+          bins[a][b].box.extend(o.bins[a][b].box);
+          bins[a][b].count += o.bins[a][b].count;
+        }
+      }
+    }
+  };
+
+  SahChoice sah_split(const BuildNode& node, const Aabb& cbox, bool parallel) const {
+    const int nb = options_.bins;
+    const BinSet bins = reduce_range(node.begin, node.end, parallel, BinSet{}, [&](uint32_t b, uint32_t e, BinSet acc) {
+      for (uint32_t i = b; i < e; ++i) {
+        const uint32_t p = prims_[i];
+        for (int a = 0; a < 3; ++a) {
+          if (cbox.hi[a] <= cbox.lo[a]) continue;
+          Bin& bin = acc.bins[a][bin_of(centroids_[p][a], cbox, a)];
+          bin.box.extend(boxes_[p]);
+          ++bin.count;
+        }
+      }
+      return acc;
+    });
+    SahChoice best;
+    best.cost = kInfinity;
+    const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
+    for (int a = 0; a < 3; ++a) {
+      if (cbox.hi[a] <= cbox.lo[a]) continue;
+      float right_cost[kMaxBins];  // area * count of bins [s, nb)
+      Aabb acc;
+      uint32_t n = 0;
+      for (int s = nb - 1; s > 0; --s) {
+        acc.extend(bins.bins[a][s].box);
+        n += bins.bins[a][s].count;
+        right_cost[s] = n ? acc.half_area() * float(n) : kInfinity;
+      }
+      acc = Aabb{};
+      n = 0;
+      for (int s = 1; s < nb; ++s) {
+        acc.extend(bins.bins[a][s - 1].box);
+        n += bins.bins[a][s - 1].count;
+        if (n == 0) continue;
+        const float cost = options_.traversal_cost +
+                           options_.intersection_cost * (acc.half_area() * float(n) + right_cost[s]) * inv_area;
+        if (cost < best.cost) best = {a, s, cost};
+      }
+    }
+    if (!(best.cost < kInfinity)) best.axis = -1;
+    return best;
+  }
+
+  // Stable partition of prims_[begin, end) by `pred`; returns the first index of the false part.
+  // The parallel path computes the same permutation as the sequential one.
+  template <class Pred>
+  uint32_t partition(uint32_t begin, uint32_t end, bool parallel, const Pred& pred) {
+    if (!parallel) {
+      uint32_t out = begin;
+      for (uint32_t i = begin; i < end; ++i) {
+        if (pred(prims_[i])) scratch_[out++] = prims_[i];
+      }
+      const uint32_t mid = out;
+      for (uint32_t i = begin; i < end; ++i) {
+        if (!pred(prims_[i])) scratch_[out++] = prims_[i];
+      }
+      std::copy(scratch_.begin() + begin, scratch_.begin() + end, prims_.begin() + begin);
+      return mid;
+    }
+    const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
+    std::vector<uint32_t> left_counts(blocks + 1, 0);
+    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
+      const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
+      uint32_t c = 0;
+      for (uint32_t i = b; i < e; ++i) c += pred(prims_[i]) ? 1 : 0;
+      left_counts[k + 1] = c;
+    });
+    for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
+    const uint32_t mid = begin + left_counts[blocks];
+    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
+      const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
+      uint32_t l = begin + left_counts[k];
+      uint32_t r = mid + (b - begin) - left_counts[k];  // rights before this block
+      for (uint32_t i = b; i < e; ++i) {
+        if (pred(prims_[i])) scratch_[l++] = prims_[i];
+        else scratch_[r++] = prims_[i];
+      }
+    });
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(begin, end, kPartitionBlock), [&](const tbb::blocked_range<uint32_t>& r) {
+      std::copy(scratch_.begin() + r.begin(), scratch_.begin() + r.end(), prims_.begin() + r.begin());
+    });
+    return mid;
+  }
+
+  BvhBuildOptions options_;
+  std::vector<uint32_t> prims_, scratch_;
+  std::vector<Aabb> boxes_;
+  std::vector<Vec3> centroids_;
+  std::vector<BuildNode> nodes_;
+  std::atomic<uint32_t> node_count_{0};
+};
+
+}  // namespace
+
+Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), options_(options) {
+  BvhBuilder builder(scene, options);
+  builder.build();
+  builder.flatten(nodes_);
+  ids_ = builder.prims();
+  tris_.reserve(ids_.size());
+  for (uint32_t id : ids_) tris_.push_back(scene.triangles[id]);
+}
+
+}  // namespace tracer

@@ -1,0 +1,104 @@
+#include "accel/embree_accel.hpp"
+
+#include <string>
+
+#include "scene/errors.hpp"
+
+namespace tracer {
+
+bool EmbreeAccel::monitor(void* user, ssize_t bytes, bool /*post*/) {
+  auto* self = static_cast<EmbreeAccel*>(user);
+  const int64_t now = self->bytes_.fetch_add(bytes) + bytes;
+  int64_t peak = self->peak_bytes_.load();
+  while (now > peak && !self->peak_bytes_.compare_exchange_weak(peak, now)) {
+  }
+  return true;
+}
+
+EmbreeAccel::EmbreeAccel(const Scene& scene) : scene_(&scene) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
+  rtc_scene_ = rtcNewScene(device_);
+  // One Embree geometry per scene geometry, attached in order, so geomID and primID coincide.
+  for (const Geometry& g : scene.geometries) {
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), 3 * size_t(g.triangle_count)));
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), g.triangle_count));
+    for (uint32_t i = 0; i < g.triangle_count; ++i) {
+      const Triangle& t = scene.triangles[g.first_triangle + i];
+      const Vec3 p[3] = {t.v0, t.v1, t.v2};
+      for (int k = 0; k < 3; ++k) {
+        v[9 * i + 3 * k] = p[k].x;
+        v[9 * i + 3 * k + 1] = p[k].y;
+        v[9 * i + 3 * k + 2] = p[k].z;
+        idx[3 * i + k] = 3 * i + unsigned(k);
+      }
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(rtc_scene_, geom);
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(rtc_scene_);
+  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw InputError("embree: scene build failed");
+}
+
+EmbreeAccel::~EmbreeAccel() {
+  if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+bool EmbreeAccel::intersect(const Ray& ray, Hit& hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.org.x;
+  rh.ray.org_y = ray.org.y;
+  rh.ray.org_z = ray.org.z;
+  rh.ray.tnear = ray.tnear;
+  rh.ray.dir_x = ray.dir.x;
+  rh.ray.dir_y = ray.dir.y;
+  rh.ray.dir_z = ray.dir.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = ray.tfar;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rtc_scene_, &context, &rh);
+  hit = Hit{};
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit.t = rh.ray.tfar;
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  hit.geomID = rh.hit.geomID;
+  hit.primID = rh.hit.primID;
+  hit.tri = scene_->geometries[rh.hit.geomID].first_triangle + rh.hit.primID;
+  return true;
+}
+
+bool EmbreeAccel::occluded(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  r.org_x = ray.org.x;
+  r.org_y = ray.org.y;
+  r.org_z = ray.org.z;
+  r.tnear = ray.tnear;
+  r.dir_x = ray.dir.x;
+  r.dir_y = ray.dir.y;
+  r.dir_z = ray.dir.z;
+  r.time = 0.0f;
+  r.tfar = ray.tfar;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(rtc_scene_, &context, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+}  // namespace tracer

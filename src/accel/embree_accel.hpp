@@ -1,0 +1,34 @@
+// Intel Embree 3 as a side-by-side reference backend (never the default): the same scene, the same
+// rays, through rtcIntersect1/rtcOccluded1 at Embree's default build quality.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <atomic>
+
+#include "math/ray.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+class EmbreeAccel {
+ public:
+  explicit EmbreeAccel(const Scene& scene);
+  ~EmbreeAccel();
+  EmbreeAccel(const EmbreeAccel&) = delete;
+  EmbreeAccel& operator=(const EmbreeAccel&) = delete;
+
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+  size_t memory_bytes() const { return static_cast<size_t>(std::max<int64_t>(0, peak_bytes_.load())); }
+
+ private:
+  static bool monitor(void* user, ssize_t bytes, bool post);
+
+  const Scene* scene_;
+  RTCDevice device_ = nullptr;
+  RTCScene rtc_scene_ = nullptr;
+  std::atomic<int64_t> bytes_{0}, peak_bytes_{0};
+};
+
+}  // namespace tracer

@@ -1,0 +1,70 @@
+// Watertight ray/triangle test (Woop, Benthin, Wald: "Watertight Ray/Triangle Intersection",
+// JCGT 2013). The ray is sheared so it runs along +z from the origin; edge functions are then
+// evaluated in 2D, and exactly-zero ones are redone in double, so a ray through a shared edge or
+// vertex hits at least one of the triangles around it. Two-sided.
+#pragma once
+
+#include <utility>
+
+#include "math/ray.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+// Per-ray constants of the shear, computed once per query.
+struct RayShear {
+  Vec3 org;
+  int kx = 0, ky = 1, kz = 2;
+  float sx = 0, sy = 0, sz = 1;
+
+  explicit RayShear(const Ray& r) : org(r.org) {
+    kz = max_dimension(abs(r.dir));
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (r.dir[kz] < 0.0f) std::swap(kx, ky);  // keep the winding so U, V, W keep their signs
+    sx = r.dir[kx] / r.dir[kz];
+    sy = r.dir[ky] / r.dir[kz];
+    sz = 1.0f / r.dir[kz];
+  }
+};
+
+struct TriangleHit {
+  float t, u, v;
+};
+
+// Hit if t lies in [tnear, tfar]; inclusive at both ends so callers can break ties on t themselves.
+inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tnear, float tfar, TriangleHit& out) {
+  const Vec3 a = tri.v0 - s.org;
+  const Vec3 b = tri.v1 - s.org;
+  const Vec3 c = tri.v2 - s.org;
+  const float ax = a[s.kx] - s.sx * a[s.kz], ay = a[s.ky] - s.sy * a[s.kz];
+  const float bx = b[s.kx] - s.sx * b[s.kz], by = b[s.ky] - s.sy * b[s.kz];
+  const float cx = c[s.kx] - s.sx * c[s.kz], cy = c[s.ky] - s.sy * c[s.kz];
+  float u = cx * by - cy * bx;
+  float v = ax * cy - ay * cx;
+  float w = bx * ay - by * ax;
+  if (u == 0.0f || v == 0.0f || w == 0.0f) [[unlikely]] {
+    // The float result is ambiguous exactly on an edge: decide it in double, where the products
+    // of two floats are exact.
+    u = float(double(cx) * double(by) - double(cy) * double(bx));
+    v = float(double(ax) * double(cy) - double(ay) * double(cx));
+    w = float(double(bx) * double(ay) - double(by) * double(ax));
+  }
+  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+  const float det = u + v + w;
+  if (det == 0.0f) return false;  // degenerate, or seen exactly edge-on
+  const float az = s.sz * a[s.kz], bz = s.sz * b[s.kz], cz = s.sz * c[s.kz];
+  const float rcp = 1.0f / det;
+  const float t = (u * az + v * bz + w * cz) * rcp;
+  if (!(t >= tnear && t <= tfar)) return false;  // also rejects NaN
+  out = {t, v * rcp, w * rcp};
+  return true;
+}
+
+// Closest-hit ordering shared by every accelerator: nearer t wins, equal t goes to the lower
+// scene triangle index, so the answer never depends on traversal order.
+inline bool closer(float t, uint32_t tri, const Hit& best) {
+  return t < best.t || (t == best.t && tri < best.tri);
+}
+
+}  // namespace tracer

@@ -1,0 +1,168 @@
+// tracer: the command-line front end. Exit codes: 0 ok, 1 bad input, 2 bad usage, 130 interrupted.
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <new>
+#include <sstream>
+
+#include "cli/progress.hpp"
+#include "cli/render_args.hpp"
+#include "io/image_io.hpp"
+#include "scene/errors.hpp"
+
+namespace tracer::cli {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+
+void install_sigint_handler() {
+  struct sigaction sa {};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;  // a second Ctrl-C kills at once
+  sigaction(SIGINT, &sa, nullptr);
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int cmd_render(const RenderArgs& args) {
+  validate(args);
+  image_format_for(args.output, "-o");
+  check_writable(args.output);
+  if (!args.stats_json.empty()) check_writable(args.stats_json);
+
+  const auto t_load = std::chrono::steady_clock::now();
+  const Scene scene = load_scene(args.scene);
+  const double load_ms = ms_since(t_load);
+  const CameraSpec camera = camera_for(scene, args);
+  const RenderSettings settings = settings_for(args);
+  const SchedOptions sched = sched_options_for(args);
+  const Accelerator accel = build_accelerator(scene, accel_options_for(args));
+
+  Framebuffer fb(settings.width, settings.height);
+  RenderContext ctx{&scene, Camera(camera, settings.width, settings.height), settings, &fb};
+  RenderControl control;
+  control.cancel = &g_interrupted;
+  install_sigint_handler();
+  const auto t_render = std::chrono::steady_clock::now();
+  bool finished;
+  {
+    ProgressBar progress(!args.quiet, uint64_t(settings.width) * uint64_t(settings.height), control.pixels_done, control.rays_done);
+    finished = render_image(accel, ctx, sched, control);
+  }
+  const double render_ms = ms_since(t_render);
+  if (!finished) {
+    if (args.save_partial) {
+      write_image(args.output, tonemap(fb, settings.exposure));
+      std::cerr << "tracer: interrupted; partial image written to " << args.output << "\n";
+    } else {
+      std::cerr << "tracer: interrupted; no image written\n";
+    }
+    return 130;
+  }
+  write_image(args.output, tonemap(fb, settings.exposure));
+
+  const RayCounts rays = control.counts.load();
+  const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
+  if (args.stats) {
+    std::printf("scene        %s (%zu triangles)\n", scene.source.c_str(), scene.size());
+    std::printf("image        %dx%d, %d AO rays per hit -> %s\n", settings.width, settings.height, settings.ao_samples, args.output.c_str());
+    std::printf("accelerator  %s, %.1f bytes/triangle\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()));
+    std::printf("scheduler    %s, %d threads\n", to_string(sched.kind).c_str(), sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads));
+    std::printf("load         %10.2f ms\n", load_ms);
+    std::printf("build        %10.2f ms\n", accel.build_ms);
+    std::printf("render       %10.2f ms\n", render_ms);
+    std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu total\n", (unsigned long long)rays.primary,
+                (unsigned long long)rays.shadow, (unsigned long long)rays.ao, (unsigned long long)rays.total());
+    std::printf("throughput   %10.2f Mrays/s\n", mrays);
+  }
+  if (!args.stats_json.empty()) {
+    std::ostringstream j;
+    j << "{\n  \"scene\": \"" << scene.source << "\",\n  \"triangles\": " << scene.size()
+      << ",\n  \"width\": " << settings.width << ",\n  \"height\": " << settings.height
+      << ",\n  \"ao_samples\": " << settings.ao_samples << ",\n  \"accel\": \"" << accel.name
+      << "\",\n  \"sched\": \"" << to_string(sched.kind) << "\",\n  \"threads\": "
+      << (sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads))
+      << ",\n  \"load_ms\": " << load_ms << ",\n  \"build_ms\": " << accel.build_ms << ",\n  \"render_ms\": " << render_ms
+      << ",\n  \"rays\": {\"primary\": " << rays.primary << ", \"shadow\": " << rays.shadow << ", \"ao\": " << rays.ao
+      << ", \"total\": " << rays.total() << "},\n  \"mrays_per_s\": " << mrays
+      << ",\n  \"accel_bytes\": " << accel.memory_bytes() << "\n}\n";
+    write_file_atomic(args.stats_json, j.str());
+  }
+  return 0;
+}
+
+int cmd_info(const SceneArgs& args) {
+  const Scene scene = load_scene(args);
+  std::printf("scene       %s\n", scene.source.c_str());
+  std::printf("triangles   %zu (%zu degenerate)\n", scene.size(), scene.degenerate_count);
+  std::printf("vertices    %zu\n", scene.vertex_count);
+  std::printf("geometries  %zu\n", scene.geometries.size());
+  std::printf("materials   %zu:", scene.materials.size());
+  for (const Material& m : scene.materials) std::printf(" %s", m.name.c_str());
+  std::printf("\nlights      %zu\n", scene.lights.size());
+  for (const Light& l : scene.lights) {
+    std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x, l.position.y,
+                l.position.z, l.power.x, l.power.y, l.power.z);
+  }
+  std::printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", scene.bounds.lo.x, scene.bounds.lo.y, scene.bounds.lo.z,
+              scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
+  return 0;
+}
+
+}  // namespace
+}  // namespace tracer::cli
+
+int main(int argc, char** argv) {
+  using namespace tracer;
+  using namespace tracer::cli;
+  CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ scenes"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "tracer 0.1.0");
+
+  RenderArgs render_args;
+  CLI::App* render = app.add_subcommand("render", "render a scene to a PNG or PPM image");
+  add_render_options(*render, render_args);
+  render->add_option("-o,--output", render_args.output, "output image, .png or .ppm")->capture_default_str();
+  render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
+  render->add_option("--stats-json", render_args.stats_json, "write the statistics as JSON to this file");
+  render->add_flag("-q,--quiet", render_args.quiet, "no progress bar");
+  render->add_flag("--save-partial", render_args.save_partial, "on Ctrl-C, write the image with unfinished tiles black");
+
+  SceneArgs info_args;
+  CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");
+  add_scene_options(*info, info_args);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "tracer: error: " << e.what() << " (see tracer --help)\n";
+    return 2;
+  }
+  try {
+    if (render->parsed()) return cmd_render(render_args);
+    if (info->parsed()) return cmd_info(info_args);
+  } catch (const UsageError& e) {
+    std::cerr << "tracer: error: " << e.what() << "\n";
+    return 2;
+  } catch (const InputError& e) {
+    std::cerr << "tracer: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "tracer: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "tracer: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,14 @@
+// Flag-value parsing shared by the commands: each failure is a one-line UsageError naming the flag.
+#pragma once
+
+#include <string>
+
+#include "math/vec.hpp"
+
+namespace tracer::cli {
+
+Vec3 parse_vec3(const std::string& flag, const std::string& text);
+void check_range(const std::string& flag, long long value, long long lo, long long hi);
+void check_range_real(const std::string& flag, double value, double lo, double hi, bool lo_open = false);
+
+}  // namespace tracer::cli

@@ -1,0 +1,32 @@
+// A progress line on stderr for long renders: percent, elapsed, ETA, Mrays/s. Shown only when
+// stderr is a terminal and the render has run for over a second; never written to logs or pipes.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <thread>
+
+namespace tracer::cli {
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels, const std::atomic<uint64_t>& rays);
+  ~ProgressBar() { stop(); }
+  void stop();
+
+ private:
+  void run();
+  uint64_t total_;
+  const std::atomic<uint64_t>& pixels_;
+  const std::atomic<uint64_t>& rays_;
+  std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stopping_ = false, drawn_ = false;
+  std::thread thread_;
+};
+
+}  // namespace tracer::cli

@@ -1,0 +1,150 @@
+#include "cli/render_args.hpp"
+
+#include "cli/parse.hpp"
+#include "scene/builtin.hpp"
+#include "scene/camera.hpp"
+#include "scene/errors.hpp"
+#include "scene/obj_loader.hpp"
+
+namespace tracer::cli {
+
+void add_scene_options(CLI::App& app, SceneArgs& a) {
+  app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)");
+  app.add_option("--builtin-spheres", a.builtin_spheres, "built-in scene: add two spheres of about this many triangles each");
+  app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
+  app.add_flag("--no-scene-lights", a.no_scene_lights, "drop the scene's emissive lights, keep only --light ones");
+  app.add_option("--light-intensity", a.light_intensity, "point light intensity (default: (scene diagonal / 2)^2)");
+}
+
+void add_render_options(CLI::App& app, RenderArgs& a) {
+  add_scene_options(app, a.scene);
+  app.add_option("--width", a.width, "image width in pixels (1-16384)")->capture_default_str();
+  app.add_option("--height", a.height, "image height in pixels (1-16384)")->capture_default_str();
+  app.add_option("--eye,-v", a.eye, "camera position x,y,z (default: frame the scene from the front)");
+  app.add_option("--look,-l", a.look, "point the camera looks at, x,y,z");
+  app.add_option("--up", a.up, "camera up vector x,y,z (default 0,1,0)");
+  app.add_option("--fov", a.fov, "vertical field of view in degrees (default 53.13)");
+  app.add_option("--ao", a.ao, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
+  app.add_option("--ao-distance", a.ao_distance, "maximum distance of AO rays (default: unbounded)");
+  app.add_option("--ambient", a.ambient, "ambient light strength")->capture_default_str();
+  app.add_option("--exposure", a.exposure, "tone-mapping exposure")->capture_default_str();
+  app.add_option("--seed", a.seed, "seed of the AO sample pattern")->capture_default_str();
+  app.add_option("--accel", a.accel, "accelerator: brute, bvh, embree")->capture_default_str();
+  app.add_option("--bvh-split", a.split, "BVH split: sah or median (the study's)")->capture_default_str();
+  app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
+  app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
+  app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-64)")->capture_default_str();
+  app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
+  app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
+  app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
+  app.add_option("--block", a.block, "pixels per row block for the queue scheduler")->capture_default_str();
+}
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+void validate(const RenderArgs& a) {
+  check_range("--width", a.width, 1, 16384);
+  check_range("--height", a.height, 1, 16384);
+  check_range("--ao", a.ao, 0, 4096);
+  if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
+  if (a.fov) check_range_real("--fov", *a.fov, 0.0, 179.0, true);
+  check_range_real("--ambient", a.ambient, 0.0, 1e6);
+  check_range_real("--exposure", a.exposure, 0.0, 1e6, true);
+  check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);
+  if (a.scene.light_intensity) check_range_real("--light-intensity", *a.scene.light_intensity, 0.0, 1e30);
+  if (a.threads) check_range("--threads", *a.threads, 1, 1024);
+  check_range("--tile", a.tile, 1, 4096);
+  check_range("--block", a.block, 1, 1 << 20);
+  check_range("--max-leaf", a.max_leaf, 1, 16);
+  check_range("--bins", a.bins, 4, 64);
+  if (!a.eye.empty()) parse_vec3("--eye", a.eye);
+  if (!a.look.empty()) parse_vec3("--look", a.look);
+  if (!a.up.empty()) {
+    if (length(parse_vec3("--up", a.up)) == 0.0f) throw UsageError("--up: must not be the zero vector");
+  }
+  for (const auto& l : a.scene.lights) parse_vec3("--light", l);
+  accel_options_for(a);
+  parse_sched(a.sched);
+}
+
+Scene load_scene(const SceneArgs& a) {
+  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene);
+  if (a.no_scene_lights) scene.lights.clear();
+  const float diag = length(scene.bounds.extent());
+  const float intensity = a.light_intensity ? float(*a.light_intensity) : 0.25f * diag * diag;
+  for (const std::string& text : a.lights) {
+    Light l;
+    l.position = parse_vec3("--light", text);
+    l.power = Vec3{intensity};
+    scene.lights.push_back(l);
+  }
+  return scene;
+}
+
+CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
+  const float fov = a.fov ? float(*a.fov) : kDefaultFovDegrees;
+  CameraSpec spec = scene.camera && a.eye.empty() && a.look.empty() && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
+  if (!a.eye.empty()) {
+    spec.eye = parse_vec3("--eye", a.eye);
+    if (a.look.empty()) spec.look = scene.bounds.center();
+  }
+  if (!a.look.empty()) spec.look = parse_vec3("--look", a.look);
+  if (!a.up.empty()) spec.up = parse_vec3("--up", a.up);
+  const Vec3 forward = spec.look - spec.eye;
+  if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
+  if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
+  return spec;
+}
+
+RenderSettings settings_for(const RenderArgs& a) {
+  RenderSettings s;
+  s.width = a.width;
+  s.height = a.height;
+  s.ao_samples = a.ao;
+  s.ao_distance = a.ao_distance ? float(*a.ao_distance) : kInfinity;
+  s.ambient = float(a.ambient);
+  s.exposure = float(a.exposure);
+  s.seed = a.seed;
+  return s;
+}
+
+AccelOptions accel_options_for(const RenderArgs& a) {
+  AccelOptions o;
+  const std::string accel = lower(a.accel);
+  if (accel == "brute") o.kind = AccelKind::Brute;
+  else if (accel == "bvh") o.kind = AccelKind::Bvh;
+  else if (accel == "embree") o.kind = AccelKind::Embree;
+  else throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, embree)");
+  const std::string split = lower(a.split);
+  if (split == "sah") o.bvh.split = BvhSplit::Sah;
+  else if (split == "median") o.bvh.split = BvhSplit::Median;
+  else throw UsageError("--bvh-split: unknown split '" + a.split + "' (sah, median)");
+  const std::string build = lower(a.build);
+  if (build == "seq") o.bvh.mode = BuildMode::Seq;
+  else if (build == "async") o.bvh.mode = BuildMode::Async;
+  else if (build == "queue") o.bvh.mode = BuildMode::Queue;
+  else if (build == "tasks") o.bvh.mode = BuildMode::Tasks;
+  else throw UsageError("--build: unknown builder '" + a.build + "' (seq, async, queue, tasks)");
+  o.bvh.threads = a.threads.value_or(0);
+  o.bvh.max_leaf = a.max_leaf;
+  o.bvh.bins = a.bins;
+  return o;
+}
+
+SchedOptions sched_options_for(const RenderArgs& a) {
+  SchedOptions o;
+  o.kind = parse_sched(lower(a.sched));
+  o.threads = a.threads.value_or(0);
+  o.tile = a.tile;
+  o.block = a.block;
+  return o;
+}
+
+}  // namespace tracer::cli

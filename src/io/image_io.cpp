@@ -1,0 +1,88 @@
+#include "io/image_io.hpp"
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "scene/errors.hpp"
+
+namespace tracer {
+
+namespace fs = std::filesystem;
+
+ImageFormat image_format_for(const std::string& path, const std::string& flag) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".png") return ImageFormat::Png;
+  if (ext == ".ppm") return ImageFormat::Ppm;
+  throw UsageError(flag + ": unsupported image extension '" + ext + "' in '" + path + "' (use .png or .ppm)");
+}
+
+void check_writable(const std::string& path) {
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(path + ": cannot write: directory '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  if (fs::is_directory(path, ec)) throw InputError(path + ": cannot write: is a directory");
+}
+
+void write_file_atomic(const std::string& path, std::string_view bytes) {
+  check_writable(path);
+  std::string tmp = path + ".tmp-XXXXXX";
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  ::fchmod(fd, 0644);
+  size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string reason = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw InputError(path + ": cannot write: " + reason);
+    }
+    written += size_t(n);
+  }
+  if (::close(fd) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw InputError(path + ": cannot write: " + reason);
+  }
+}
+
+void write_image(const std::string& path, const Image8& image) {
+  std::string bytes;
+  if (image_format_for(path) == ImageFormat::Ppm) {
+    bytes = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
+    bytes.append(reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
+  } else {
+    const auto sink = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size)); };
+    if (!stbi_write_png_to_func(sink, &bytes, image.width, image.height, 3, image.rgb.data(), image.width * 3)) {
+      throw InputError(path + ": PNG encoding failed");
+    }
+  }
+  write_file_atomic(path, bytes);
+}
+
+Image8 read_image(const std::string& path) {
+  int w = 0, h = 0, channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 3);  // stb reads PNG and binary PPM
+  if (!data) throw InputError(path + ": cannot read image: " + stbi_failure_reason());
+  Image8 img;
+  img.width = w;
+  img.height = h;
+  img.rgb.assign(data, data + size_t(w) * size_t(h) * 3);
+  stbi_image_free(data);
+  return img;
+}
+
+}  // namespace tracer

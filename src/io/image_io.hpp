@@ -1,0 +1,30 @@
+// Writing images and other outputs atomically: a temporary file in the target directory, then
+// rename, so no failed or interrupted run leaves a truncated file behind.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "render/framebuffer.hpp"
+
+namespace tracer {
+
+enum class ImageFormat { Png, Ppm };
+
+// From the path's extension (.png or .ppm, any case); throws UsageError naming `flag` otherwise.
+ImageFormat image_format_for(const std::string& path, const std::string& flag = "-o");
+
+// Encodes and writes; throws InputError("PATH: cannot write: reason") on failure.
+void write_image(const std::string& path, const Image8& image);
+
+// Writes bytes to path via temp file + rename; throws InputError on failure.
+void write_file_atomic(const std::string& path, std::string_view bytes);
+
+// Checks up front that `path`'s directory exists and is writable, so a long render does not end
+// in an unwritable path; throws InputError.
+void check_writable(const std::string& path);
+
+// Reads a PNG or PPM written by write_image (tests, image comparison); throws InputError.
+Image8 read_image(const std::string& path);
+
+}  // namespace tracer

@@ -1,0 +1,46 @@
+#include "render/framebuffer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tracer {
+
+std::vector<Tile> make_tiles(int width, int height, int tile_w, int tile_h) {
+  std::vector<Tile> tiles;
+  for (int y = 0; y < height; y += tile_h) {
+    for (int x = 0; x < width; x += tile_w) {
+      tiles.push_back({x, y, std::min(x + tile_w, width), std::min(y + tile_h, height)});
+    }
+  }
+  return tiles;
+}
+
+namespace {
+
+uint8_t encode(float linear, float exposure) {
+  if (!(linear > 0.0f)) return 0;  // also maps NaN to black
+  const float mapped = 1.0f - std::exp(-exposure * linear);
+  const float srgb = mapped <= 0.0031308f ? 12.92f * mapped : 1.055f * std::pow(mapped, 1.0f / 2.4f) - 0.055f;
+  return static_cast<uint8_t>(std::clamp(std::lround(srgb * 255.0f), 0L, 255L));
+}
+
+}  // namespace
+
+Image8 tonemap(const Framebuffer& fb, float exposure) {
+  Image8 img;
+  img.width = fb.width();
+  img.height = fb.height();
+  img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
+  size_t k = 0;
+  for (int y = 0; y < fb.height(); ++y) {
+    for (int x = 0; x < fb.width(); ++x) {
+      const Vec3 c = fb.at(x, y);
+      img.rgb[k++] = encode(c.x, exposure);
+      img.rgb[k++] = encode(c.y, exposure);
+      img.rgb[k++] = encode(c.z, exposure);
+    }
+  }
+  return img;
+}
+
+}  // namespace tracer

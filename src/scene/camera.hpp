@@ -1,0 +1,57 @@
+// Pinhole camera: one primary ray through each pixel centre.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+
+#include "math/ray.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+// The default vertical field of view, 2*atan(1/2) = 53.13 degrees: with it the default framing of
+// the McGuire Cornell files (2 units wide, centred at 0,1,0) puts the eye at 0,1,3, the study's camera.
+inline constexpr float kDefaultFovDegrees = 53.130102f;
+
+// Frames `bounds` from the front (+z looking down -z): the front face fills the view vertically
+// or horizontally, whichever is larger.
+inline CameraSpec frame_bounds(const Aabb& bounds, float fov_degrees = kDefaultFovDegrees) {
+  const Vec3 c = bounds.center();
+  const Vec3 half = bounds.extent() * 0.5f;
+  const float tan_half = std::tan(fov_degrees * float(std::numbers::pi) / 360.0f);
+  const float distance = std::max(half.x, half.y) / tan_half + half.z;
+  return CameraSpec{c + Vec3{0.0f, 0.0f, distance}, c, {0.0f, 1.0f, 0.0f}, fov_degrees};
+}
+
+class Camera {
+ public:
+  Camera() = default;
+  Camera(const CameraSpec& spec, int width, int height) : eye_(spec.eye) {
+    const Vec3 forward = normalize(spec.look - spec.eye);
+    const Vec3 right = normalize(cross(forward, spec.up));
+    const Vec3 up = cross(right, forward);
+    const float tan_half = std::tan(spec.fov_degrees * float(std::numbers::pi) / 360.0f);
+    const float aspect = float(width) / float(height);
+    // Pixel (x, y) maps to forward + (2*(x+0.5)/w - 1)*du + (1 - 2*(y+0.5)/h)*dv.
+    du_ = right * (tan_half * aspect);
+    dv_ = up * tan_half;
+    forward_ = forward;
+    inv_w_ = 1.0f / float(width);
+    inv_h_ = 1.0f / float(height);
+  }
+
+  Ray primary_ray(int x, int y) const {
+    const float sx = 2.0f * (float(x) + 0.5f) * inv_w_ - 1.0f;
+    const float sy = 1.0f - 2.0f * (float(y) + 0.5f) * inv_h_;
+    Ray r;
+    r.org = eye_;
+    r.dir = normalize(forward_ + du_ * sx + dv_ * sy);
+    return r;
+  }
+
+ private:
+  Vec3 eye_, forward_, du_, dv_;
+  float inv_w_ = 1.0f, inv_h_ = 1.0f;
+};
+
+}  // namespace tracer

@@ -1,0 +1,68 @@
+#include "scene/scene.hpp"
+
+#include <map>
+#include <utility>
+
+namespace tracer {
+
+bool Triangle::degenerate() const {
+  // Exact test in double: float rounding must not turn a collinear triple into a sliver.
+  const double ax = double(v1.x) - v0.x, ay = double(v1.y) - v0.y, az = double(v1.z) - v0.z;
+  const double bx = double(v2.x) - v0.x, by = double(v2.y) - v0.y, bz = double(v2.z) - v0.z;
+  const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+  return cx == 0.0 && cy == 0.0 && cz == 0.0;
+}
+
+void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
+                     const std::vector<uint32_t>& indices, uint32_t material) {
+  Geometry g;
+  g.name = name;
+  g.first_triangle = static_cast<uint32_t>(triangles.size());
+  g.triangle_count = static_cast<uint32_t>(indices.size() / 3);
+  const auto geom_id = static_cast<uint32_t>(geometries.size());
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    triangles.push_back({vertices[indices[i]], vertices[indices[i + 1]], vertices[indices[i + 2]]});
+    tri_geom.push_back(geom_id);
+    tri_prim.push_back(static_cast<uint32_t>(i / 3));
+    tri_material.push_back(material);
+  }
+  vertex_count += vertices.size();
+  geometries.push_back(std::move(g));
+}
+
+void Scene::finalize() {
+  bounds = Aabb{};
+  degenerate_count = 0;
+  for (const Triangle& t : triangles) {
+    bounds.extend(t.bounds());
+    degenerate_count += t.degenerate() ? 1 : 0;
+  }
+  // One area light per (geometry, emissive material): the Cornell lamp is one quad, one light.
+  std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
+  struct Accum { Vec3 weighted_centroid, normal; float area = 0; Vec3 ke; };
+  std::map<std::pair<uint32_t, uint32_t>, Accum> emitters;
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    const Material& m = materials[tri_material[i]];
+    if (!m.emissive() || triangles[i].degenerate()) continue;
+    Accum& a = emitters[{tri_geom[i], tri_material[i]}];
+    const Vec3 n = triangles[i].normal();
+    const float area = 0.5f * length(n);
+    a.weighted_centroid += triangles[i].centroid() * area;
+    a.normal += n * 0.5f;
+    a.area += area;
+    a.ke = m.ke;
+  }
+  for (const auto& [key, a] : emitters) {
+    if (a.area <= 0.0f) continue;
+    Light l;
+    l.position = a.weighted_centroid / a.area;
+    const float n_len = length(a.normal);
+    l.normal = n_len > 0.0f ? a.normal / n_len : Vec3{0.0f, -1.0f, 0.0f};
+    l.power = a.ke * a.area;
+    l.area = a.area;
+    l.geomID = key.first;
+    lights.push_back(l);
+  }
+}
+
+}  // namespace tracer

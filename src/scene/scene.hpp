@@ -1,0 +1,88 @@
+// The scene: triangles in flat arrays (what every accelerator reads), their materials, lights and
+// an optional camera the scene suggests.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "math/aabb.hpp"
+#include "math/vec.hpp"
+
+namespace tracer {
+
+struct Triangle {
+  Vec3 v0, v1, v2;
+
+  Aabb bounds() const {
+    Aabb b;
+    b.extend(v0);
+    b.extend(v1);
+    b.extend(v2);
+    return b;
+  }
+  Vec3 centroid() const { return (v0 + v1 + v2) * (1.0f / 3.0f); }
+  // Unnormalised geometric normal, (v1-v0) x (v2-v0): counter-clockwise faces point at the viewer.
+  Vec3 normal() const { return cross(v1 - v0, v2 - v0); }
+  // Zero area in exact arithmetic (collinear or coincident vertices): such a triangle never hits.
+  bool degenerate() const;
+};
+
+// OBJ material; Ks, Ni and illum are kept for the mirror/glass work of later issues.
+struct Material {
+  std::string name = "default";
+  Vec3 kd{0.7f};
+  Vec3 ks{0.0f};
+  Vec3 ke{0.0f};
+  float ni = 1.0f;
+  int illum = 2;
+  bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
+};
+
+// An area light is approximated by its area-weighted centroid (one shadow ray per light, as in the
+// study); `power` is Ke times area. A point light has a zero normal and `power` is its intensity.
+struct Light {
+  Vec3 position;
+  Vec3 normal;
+  Vec3 power;
+  float area = 0.0f;             // emitting area (0 for point lights)
+  uint32_t geomID = UINT32_MAX;  // the emitting geometry, or UINT32_MAX for point lights
+  bool is_point() const { return normal == Vec3{0.0f}; }
+};
+
+// One OBJ group/object: geomID is its index, primID counts triangles from `first_triangle`.
+struct Geometry {
+  std::string name;
+  uint32_t first_triangle = 0;
+  uint32_t triangle_count = 0;
+};
+
+struct CameraSpec {
+  Vec3 eye, look, up{0.0f, 1.0f, 0.0f};
+  float fov_degrees = 0.0f;
+};
+
+struct Scene {
+  std::string source;  // file path or built-in name
+  std::vector<Triangle> triangles;
+  std::vector<uint32_t> tri_geom;      // geomID per triangle
+  std::vector<uint32_t> tri_prim;      // primID per triangle
+  std::vector<uint32_t> tri_material;  // index into materials
+  std::vector<Geometry> geometries;
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  size_t vertex_count = 0;
+  size_t degenerate_count = 0;
+  Aabb bounds;
+  std::optional<CameraSpec> camera;  // a camera the scene itself suggests (the built-in box)
+
+  size_t size() const { return triangles.size(); }
+  // Appends a geometry from an indexed mesh; material is an index into `materials`.
+  void add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
+                const std::vector<uint32_t>& indices, uint32_t material);
+  // Recomputes bounds, degenerate count and the area lights from emissive materials.
+  void finalize();
+};
+
+}  // namespace tracer
