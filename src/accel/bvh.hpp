@@ -71,24 +71,32 @@ class Bvh {
   std::vector<uint32_t> ids_;
 };
 
-// Slab test against a box with a per-ray reciprocal direction. Zero direction components get a
-// huge finite reciprocal, so no 0*inf NaN arises for origins on a slab plane; the far distance is
-// scaled up by 1 + 2*gamma(3) (Ize 2013) so rounding can never cull a box the ray touches.
+// Slab test with a per-ray reciprocal direction (Williams et al. 2005, as pbrt does it): a zero
+// direction component gives an infinite reciprocal, and an origin exactly on that slab's plane
+// gives 0*inf = NaN, which the comparisons below drop, so such a slab never culls. The far
+// distance is scaled by 1 + 2*gamma(3) (Ize 2013) so rounding never culls a box the ray touches.
 struct RayBoxTest {
+  // Boxes are also kept when entered up to ~16 ulps beyond tfar: a box's entry distance and a
+  // triangle's t round differently, and a triangle hit at exactly the current closest t must
+  // still be reached so ties resolve the same way as in brute force.
+  static constexpr float kTieGuard = 1.0f + 0x1p-20f;
   Vec3 org, inv;
+  bool neg[3];
   explicit RayBoxTest(const Ray& r) : org(r.org) {
-    const auto rcp = [](float d) { return std::fabs(d) < 1e-20f ? std::copysign(1e20f, d) : 1.0f / d; };
-    inv = {rcp(r.dir.x), rcp(r.dir.y), rcp(r.dir.z)};
+    inv = {1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z};
+    for (int a = 0; a < 3; ++a) neg[a] = std::signbit(inv[a]);
   }
-  // Entry distance, or +inf on a miss.
+  // Entry distance, or +inf on a miss. tnear and tfar must not be NaN.
   float enter(const Vec3& lo, const Vec3& hi, float tnear, float tfar) const {
     constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
-    const float tx0 = (lo.x - org.x) * inv.x, tx1 = (hi.x - org.x) * inv.x;
-    const float ty0 = (lo.y - org.y) * inv.y, ty1 = (hi.y - org.y) * inv.y;
-    const float tz0 = (lo.z - org.z) * inv.z, tz1 = (hi.z - org.z) * inv.z;
-    const float tmin = std::max(std::max(std::min(tx0, tx1), std::min(ty0, ty1)), std::max(std::min(tz0, tz1), tnear));
-    const float tmax = std::min(std::min(std::max(tx0, tx1), std::max(ty0, ty1)), std::max(tz0, tz1)) * kGuard;
-    return (tmin <= tmax && tmin <= tfar) ? tmin : kInfinity;
+    float t0 = tnear, t1 = tfar * kTieGuard;
+    for (int a = 0; a < 3; ++a) {
+      const float n = ((neg[a] ? hi[a] : lo[a]) - org[a]) * inv[a];
+      const float f = ((neg[a] ? lo[a] : hi[a]) - org[a]) * inv[a] * kGuard;
+      t0 = n > t0 ? n : t0;  // NaN n leaves t0 alone
+      t1 = f < t1 ? f : t1;  // NaN f leaves t1 alone
+    }
+    return t0 <= t1 ? t0 : kInfinity;
   }
 };
 

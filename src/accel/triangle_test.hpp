@@ -56,7 +56,7 @@ inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tne
   const float az = s.sz * a[s.kz], bz = s.sz * b[s.kz], cz = s.sz * c[s.kz];
   const float rcp = 1.0f / det;
   const float t = (u * az + v * bz + w * cz) * rcp;
-  if (!(t >= tnear && t <= tfar)) return false;  // also rejects NaN
+  if (!(t >= tnear && t <= tfar && t < kInfinity)) return false;  // also rejects NaN and overflow
   out = {t, v * rcp, w * rcp};
   return true;
 }

@@ -141,6 +141,15 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");
   add_scene_options(*info, info_args);
 
+  // CLI11 reports an unknown command as "A subcommand is required"; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    try {
+      app.get_subcommand(argv[1]);
+    } catch (const CLI::OptionNotFound&) {
+      std::cerr << "tracer: error: unknown command '" << argv[1] << "' (render, info, bench)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

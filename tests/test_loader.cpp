@@ -1,0 +1,165 @@
+// Loading: the study's four scenes give the right counts, materials and light; every kind of bad
+// input gives a one-line error that names the file and line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "scene/builtin.hpp"
+#include "scene/errors.hpp"
+#include "scene/obj_loader.hpp"
+#include "test_util.hpp"
+
+namespace tracer {
+namespace {
+
+struct Expected {
+  const char* file;
+  size_t triangles;
+};
+
+TEST(Loader, StudyScenesHaveTheRightCounts) {
+  if (!test::have_shared_scenes()) GTEST_SKIP() << "../shared/scenes not present";
+  for (const Expected& e : {Expected{"CornellBox-Original.obj", 36}, Expected{"CornellBox-Mirror.obj", 36},
+                            Expected{"CornellBox-Sphere.obj", 2188}, Expected{"CornellBox-Water.obj", 7088}}) {
+    SCOPED_TRACE(e.file);
+    std::vector<std::string> warnings;
+    const Scene s = load_obj(test::scene_path(std::string("cornell-box/") + e.file), [&](const std::string& w) { warnings.push_back(w); });
+    EXPECT_EQ(s.size(), e.triangles);
+    EXPECT_EQ(s.tri_geom.size(), e.triangles);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_GT(s.lights[0].power.x, 0.0f);
+    EXPECT_NEAR(s.lights[0].position.y, 1.98f, 0.42f);  // the lamp hangs just under the ceiling
+    EXPECT_GE(s.materials.size(), 7u);
+    const auto light = std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "light"; });
+    ASSERT_NE(light, s.materials.end());
+    EXPECT_TRUE(light->emissive());
+    EXPECT_EQ(s.degenerate_count, 0u);
+    // geomID and primID together name each triangle once
+    for (size_t i = 0; i < s.size(); ++i) {
+      const Geometry& g = s.geometries[s.tri_geom[i]];
+      EXPECT_EQ(g.first_triangle + s.tri_prim[i], i);
+    }
+  }
+}
+
+TEST(Loader, OriginalMaterialsAreRead) {
+  if (!test::have_shared_scenes()) GTEST_SKIP();
+  const Scene s = load_obj(test::scene_path("cornell-box/CornellBox-Original.obj"));
+  const auto red = std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "leftWall"; });
+  ASSERT_NE(red, s.materials.end());
+  EXPECT_FLOAT_EQ(red->kd.x, 0.63f);
+  EXPECT_FLOAT_EQ(red->kd.y, 0.065f);
+  EXPECT_FLOAT_EQ(red->ni, 1.5f);
+  EXPECT_EQ(red->illum, 2);
+}
+
+TEST(Loader, PolygonsNegativeIndicesAndCrlf) {
+  const std::string obj = "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nv 0.5 1.5 0\r\ng quad\r\nf -5 -4 -3 -2 -1\r\n";
+  const Scene s = load_obj_from_string(obj, "", "pentagon.obj");
+  EXPECT_EQ(s.size(), 3u);  // a pentagon fans into three triangles
+  EXPECT_EQ(s.geometries.size(), 1u);
+  EXPECT_EQ(s.geometries[0].name, "quad");
+  EXPECT_EQ(s.triangles[0].v0, (Vec3{0, 0, 0}));
+}
+
+TEST(Loader, GroupsBecomeGeometries) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 2 3\nf 3 2 1\n";
+  const Scene s = load_obj_from_string(obj, "", "groups.obj");
+  ASSERT_EQ(s.geometries.size(), 2u);
+  EXPECT_EQ(s.tri_geom[2], 1u);
+  EXPECT_EQ(s.tri_prim[2], 1u);
+}
+
+TEST(Loader, EmissiveMaterialMakesOneLightPerGeometry) {
+  const std::string obj = "mtllib x.mtl\nv 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\ng lamp\nusemtl glow\nf 1 2 3 4\n";
+  const std::string mtl = "newmtl glow\nKd 0.5 0.5 0.5\nKe 2 3 4\n";
+  const Scene s = load_obj_from_string(obj, mtl, "lamp.obj");
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_NEAR(s.lights[0].position.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(s.lights[0].position.z, 0.5f, 1e-6f);
+  EXPECT_NEAR(s.lights[0].area, 1.0f, 1e-6f);
+  EXPECT_NEAR(s.lights[0].power.y, 3.0f, 1e-5f);
+}
+
+struct BadObj {
+  const char* name;
+  const char* text;
+  const char* message;  // must appear in the error
+};
+
+TEST(Loader, BadInputsGiveOneLineErrorsWithLine) {
+  const BadObj cases[] = {
+      {"nan", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "bad.obj:2: non-finite coordinate 'nan'"},
+      {"inf", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", "bad.obj:3: non-finite coordinate 'inf'"},
+      {"short_vertex", "v 0 0\n", "bad.obj:1: 'v' needs 3 numbers, got 2"},
+      {"garbage_number", "v 0 0 x1\n", "bad.obj:1: malformed number 'x1'"},
+      {"index_too_big", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "bad.obj:4: vertex index 4 out of range (3 defined so far)"},
+      {"index_zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "bad.obj:4: vertex index 0 out of range"},
+      {"negative_too_far", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "bad.obj:4: vertex index -4 out of range"},
+      {"forward_reference", "v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n", "bad.obj:2: vertex index 2 out of range"},
+      {"normal_out_of_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n", "bad.obj:5: normal index 2 out of range"},
+      {"two_corner_face", "v 0 0 0\nv 1 0 0\nf 1 2\n", "bad.obj:3: face needs at least 3 vertices, got 2"},
+      {"bad_face_token", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a\n", "bad.obj:4: malformed face index 'a'"},
+      {"no_triangles", "v 0 0 0\nv 1 0 0\n", "bad.obj: scene has no triangles"},
+      {"empty_file", "", "bad.obj: scene has no triangles"},
+      {"huge_number", "v 0 0 1e999\n", "bad.obj:1: number out of range '1e999'"},
+  };
+  for (const BadObj& c : cases) {
+    SCOPED_TRACE(c.name);
+    try {
+      load_obj_from_string(c.text, "", "bad.obj", [](const std::string&) {});
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.message), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
+    }
+  }
+}
+
+TEST(Loader, MissingFileAndDirectory) {
+  EXPECT_THROW(load_obj("/nonexistent/scene.obj"), InputError);
+  EXPECT_THROW(load_obj(std::filesystem::temp_directory_path().string()), InputError);
+  try {
+    load_obj("/nonexistent/scene.obj");
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/scene.obj: cannot open: no such file");
+  }
+}
+
+TEST(Loader, MissingMtlAndTexturesWarnAndFallBack) {
+  const std::string dir = test::temp_dir();
+  {
+    std::ofstream(dir + "/a.obj") << "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    std::ofstream(dir + "/b.obj") << "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl t\nf 1 2 3\n";
+    std::ofstream(dir + "/b.mtl") << "newmtl t\nKd 0.1 0.2 0.3\nmap_Kd nowhere.png\n";
+  }
+  std::vector<std::string> warnings;
+  const auto sink = [&](const std::string& w) { warnings.push_back(w); };
+  const Scene a = load_obj(dir + "/a.obj", sink);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_NE(warnings[0].find("missing.mtl"), std::string::npos) << warnings[0];
+  EXPECT_EQ(a.size(), 1u);
+  EXPECT_EQ(a.materials[a.tri_material[0]].name, "default");
+  warnings.clear();
+  const Scene b = load_obj(dir + "/b.obj", sink);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("nowhere.png"), std::string::npos);
+  EXPECT_FLOAT_EQ(b.materials[b.tri_material[0]].kd.z, 0.3f);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Loader, BuiltinCornellBox) {
+  const Scene plain = make_cornell_box(0);
+  EXPECT_EQ(plain.size(), 32u);  // 5 walls, lamp, 2 blocks of 5 faces: 16 quads
+  ASSERT_EQ(plain.lights.size(), 1u);
+  EXPECT_TRUE(plain.camera.has_value());
+  const Scene spheres = make_cornell_box(1000);
+  EXPECT_GT(spheres.size(), 32u + 2 * 800u);
+  EXPECT_LT(spheres.size(), 32u + 2 * 1200u);
+  EXPECT_EQ(spheres.degenerate_count, 0u);
+}
+
+}  // namespace
+}  // namespace tracer

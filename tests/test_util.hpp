@@ -1,0 +1,38 @@
+// Shared helpers for the tests: scene paths, random rays, running the CLI, image comparison.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "math/ray.hpp"
+#include "render/framebuffer.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer::test {
+
+std::string scene_path(const std::string& relative);  // under ../shared/scenes
+bool have_shared_scenes();
+
+// Deterministic random rays: origins in the scene's box grown by 20%, uniform directions.
+std::vector<Ray> random_rays(const Scene& scene, size_t count, uint32_t seed);
+
+// How many rays a test should trace: TRACER_TEST_RAYS overrides `dflt` (sanitizer runs lower it).
+size_t ray_budget(size_t dflt);
+
+struct CommandResult {
+  int exit_code;
+  std::string output;  // stdout and stderr together
+};
+// Runs the tracer binary with `args` (shell-quoted by the caller).
+CommandResult run_tracer(const std::string& args);
+
+// A scene of loose triangles, one geometry, default material, finalized.
+Scene scene_of(const std::vector<Triangle>& tris);
+
+double psnr(const Image8& a, const Image8& b);
+
+// A fresh temporary directory for one test.
+std::string temp_dir();
+
+}  // namespace tracer::test
