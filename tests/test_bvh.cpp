@@ -153,8 +153,7 @@ TEST(BvhAgreement, RenderedImagesMatchBruteForce) {
   }
 }
 
-TEST(BuildDeterminism, ParallelBuildersMatchSequentialTree) {
-  const Scene scene = make_cornell_box(40'000);  // large enough for the parallel top-level passes
+void expect_parallel_builds_match(const Scene& scene) {
   for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
     BvhBuildOptions seq;
     seq.split = split;
@@ -173,6 +172,15 @@ TEST(BuildDeterminism, ParallelBuildersMatchSequentialTree) {
       }
     }
   }
+}
+
+TEST(BuildDeterminism, ParallelBuildersMatchSequentialTree) {
+  expect_parallel_builds_match(make_cornell_box(40'000));  // large enough for the parallel top-level passes
+}
+
+TEST(BuildDeterminism, ParallelBuildersMatchOnSphereScene) {
+  if (!test::have_shared_scenes()) GTEST_SKIP();
+  expect_parallel_builds_match(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
 }
 
 TEST(BvhQuality, SahBeatsMedianAndStaysSmall) {

@@ -66,29 +66,34 @@ bool Bvh::occluded(const Ray& ray) const {
   if (nodes_.empty()) return false;
   const RayShear shear(ray);
   const RayBoxTest box(ray);
+  if (box.enter(nodes_[0].lo, nodes_[0].hi, ray.tnear, ray.tfar) == kInfinity) return false;
   uint32_t stack[kMaxDepth + 2];
   int sp = 0;
-  stack[sp++] = 0;
-  while (sp > 0) {
-    const BvhNode& node = nodes_[stack[--sp]];
-    if (box.enter(node.lo, node.hi, ray.tnear, ray.tfar) == kInfinity) continue;
+  uint32_t current = 0;
+  for (;;) {
+    const BvhNode& node = nodes_[current];
     if (node.leaf()) {
       TriangleHit th;
       for (uint32_t i = node.index, end = node.index + node.count; i < end; ++i) {
         if (intersect_triangle(shear, tris_[i], ray.tnear, ray.tfar, th)) return true;
       }
     } else {
-      // Any hit ends the query, so order matters less; still visit the child nearer the origin
-      // along the ray first (the one on the ray's side of the split), pushed last.
+      // Children are tested from the parent, nearer first: any hit ends the query, and the nearer
+      // box is the likelier blocker.
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];
-      const int axis = max_dimension(abs(ray.dir));
-      const bool a_first = (a.lo[axis] + a.hi[axis] < b.lo[axis] + b.hi[axis]) == (ray.dir[axis] >= 0.0f);
-      stack[sp++] = a_first ? node.index + 1 : node.index;
-      stack[sp++] = a_first ? node.index : node.index + 1;
+      const float ta = box.enter(a.lo, a.hi, ray.tnear, ray.tfar);
+      const float tb = box.enter(b.lo, b.hi, ray.tnear, ray.tfar);
+      if (ta != kInfinity || tb != kInfinity) {
+        const bool a_first = ta <= tb;
+        if (ta != kInfinity && tb != kInfinity) stack[sp++] = a_first ? node.index + 1 : node.index;
+        current = a_first ? node.index : node.index + 1;
+        continue;
+      }
     }
+    if (sp == 0) return false;
+    current = stack[--sp];
   }
-  return false;
 }
 
 BvhStats Bvh::stats() const {

@@ -81,21 +81,26 @@ struct RayBoxTest {
   // still be reached so ties resolve the same way as in brute force.
   static constexpr float kTieGuard = 1.0f + 0x1p-20f;
   Vec3 org, inv;
-  bool neg[3];
+  bool neg_x, neg_y, neg_z;
   explicit RayBoxTest(const Ray& r) : org(r.org) {
     inv = {1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z};
-    for (int a = 0; a < 3; ++a) neg[a] = std::signbit(inv[a]);
+    neg_x = std::signbit(inv.x);
+    neg_y = std::signbit(inv.y);
+    neg_z = std::signbit(inv.z);
   }
   // Entry distance, or +inf on a miss. tnear and tfar must not be NaN.
   float enter(const Vec3& lo, const Vec3& hi, float tnear, float tfar) const {
     constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
     float t0 = tnear, t1 = tfar * kTieGuard;
-    for (int a = 0; a < 3; ++a) {
-      const float n = ((neg[a] ? hi[a] : lo[a]) - org[a]) * inv[a];
-      const float f = ((neg[a] ? lo[a] : hi[a]) - org[a]) * inv[a] * kGuard;
+    const auto slab = [&](float l, float h, float o, float i, bool neg) {
+      const float n = ((neg ? h : l) - o) * i;
+      const float f = ((neg ? l : h) - o) * i * kGuard;
       t0 = n > t0 ? n : t0;  // NaN n leaves t0 alone
       t1 = f < t1 ? f : t1;  // NaN f leaves t1 alone
-    }
+    };
+    slab(lo.x, hi.x, org.x, inv.x, neg_x);
+    slab(lo.y, hi.y, org.y, inv.y, neg_y);
+    slab(lo.z, hi.z, org.z, inv.z, neg_z);
     return t0 <= t1 ? t0 : kInfinity;
   }
 };

@@ -34,9 +34,10 @@ struct TriangleHit {
 
 // Hit if t lies in [tnear, tfar]; inclusive at both ends so callers can break ties on t themselves.
 inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tnear, float tfar, TriangleHit& out) {
-  const Vec3 a = tri.v0 - s.org;
-  const Vec3 b = tri.v1 - s.org;
-  const Vec3 c = tri.v2 - s.org;
+  // Vertices relative to the origin, as arrays so the permuted axes are plain indexed loads.
+  const float a[3] = {tri.v0.x - s.org.x, tri.v0.y - s.org.y, tri.v0.z - s.org.z};
+  const float b[3] = {tri.v1.x - s.org.x, tri.v1.y - s.org.y, tri.v1.z - s.org.z};
+  const float c[3] = {tri.v2.x - s.org.x, tri.v2.y - s.org.y, tri.v2.z - s.org.z};
   const float ax = a[s.kx] - s.sx * a[s.kz], ay = a[s.ky] - s.sy * a[s.kz];
   const float bx = b[s.kx] - s.sx * b[s.kz], by = b[s.ky] - s.sy * b[s.kz];
   const float cx = c[s.kx] - s.sx * c[s.kz], cy = c[s.ky] - s.sy * c[s.kz];

@@ -9,6 +9,7 @@
 #include <new>
 #include <sstream>
 
+#include "cli/bench.hpp"
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
 #include "io/image_io.hpp"
@@ -141,6 +142,10 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");
   add_scene_options(*info, info_args);
 
+  BenchArgs bench_args;
+  CLI::App* bench = app.add_subcommand("bench", "time the study's variants and ours on the Cornell scenes and more");
+  add_bench_options(*bench, bench_args);
+
   // CLI11 reports an unknown command as "A subcommand is required"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
     try {
@@ -160,6 +165,7 @@ int main(int argc, char** argv) {
   try {
     if (render->parsed()) return cmd_render(render_args);
     if (info->parsed()) return cmd_info(info_args);
+    if (bench->parsed()) return run_bench(bench_args);
   } catch (const UsageError& e) {
     std::cerr << "tracer: error: " << e.what() << "\n";
     return 2;

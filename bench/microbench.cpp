@@ -1,0 +1,172 @@
+// Google Benchmark microbenchmarks: the triangle and box tests, BVH builds per split and builder,
+// and traversal throughput per ray type (primary, shadow, AO) for every accelerator, on the rays
+// the renderer really traces. Run: build/release/bench/tracer_microbench [--benchmark_filter=...]
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "accel/accelerator.hpp"
+#include "render/shading.hpp"
+#include "scene/builtin.hpp"
+#include "scene/camera.hpp"
+#include "scene/obj_loader.hpp"
+
+namespace tracer {
+namespace {
+
+struct RecordedRays {
+  std::vector<Ray> primary, shadow, ao;
+};
+
+// Records the workload's rays by rendering with a recording accelerator over the SAH BVH.
+struct Recorder {
+  const Bvh* bvh;
+  RecordedRays* out;
+  int ao_samples;
+  mutable int pending_shadow = 0;
+  bool intersect(const Ray& r, Hit& h) const {
+    out->primary.push_back(r);
+    return bvh->intersect(r, h);
+  }
+  bool occluded(const Ray& r) const {
+    // shade_pixel traces the shadow rays first, then the AO rays, which are the ones with the
+    // AO tfar; distinguish by tfar (finite for shadow rays, infinite for AO rays here).
+    (r.tfar == kInfinity ? out->ao : out->shadow).push_back(r);
+    return bvh->occluded(r);
+  }
+};
+
+struct SceneCase {
+  std::string name;
+  std::shared_ptr<Scene> scene;
+  std::shared_ptr<Bvh> bvh;
+  RecordedRays rays;
+};
+
+std::vector<SceneCase>& cases() {
+  static std::vector<SceneCase> all = [] {
+    std::vector<SceneCase> v;
+    const auto add = [&](const std::string& name, Scene s) {
+      SceneCase c;
+      c.name = name;
+      c.scene = std::make_shared<Scene>(std::move(s));
+      c.bvh = std::make_shared<Bvh>(*c.scene, BvhBuildOptions{});
+      RenderSettings rs;
+      rs.width = rs.height = 128;
+      rs.ao_samples = 4;
+      Framebuffer fb(rs.width, rs.height);
+      const CameraSpec cam = c.scene->camera ? *c.scene->camera : frame_bounds(c.scene->bounds);
+      RenderContext ctx{c.scene.get(), Camera(cam, rs.width, rs.height), rs, &fb};
+      Recorder rec{c.bvh.get(), &c.rays, rs.ao_samples};
+      render_tile(rec, ctx, Tile{0, 0, rs.width, rs.height});
+      v.push_back(std::move(c));
+    };
+    add("builtin-spheres", make_cornell_box(20000));
+    const std::string dir = TRACER_SCENES_DIR;
+    for (const auto& [name, path] : {std::pair{"Sphere", "/cornell-box/CornellBox-Sphere.obj"}, {"Water", "/cornell-box/CornellBox-Water.obj"},
+                                     {"Sponza", "/sponza/sponza.obj"}, {"Sibenik", "/sibenik/sibenik.obj"}, {"Bunny", "/bunny/bunny.obj"}}) {
+      if (std::filesystem::exists(dir + path)) add(name, load_obj(dir + path, [](const std::string&) {}));
+    }
+    return v;
+  }();
+  return all;
+}
+
+void BM_TriangleTest(benchmark::State& state) {
+  const SceneCase& c = cases().front();
+  const Ray ray = c.rays.primary[c.rays.primary.size() / 2];
+  const RayShear shear(ray);
+  const auto& tris = c.scene->triangles;
+  size_t hits = 0;
+  for (auto _ : state) {
+    for (const Triangle& t : tris) {
+      TriangleHit th;
+      hits += intersect_triangle(shear, t, 0.0f, kInfinity, th) ? 1 : 0;
+    }
+  }
+  benchmark::DoNotOptimize(hits);
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(tris.size()));
+}
+BENCHMARK(BM_TriangleTest);
+
+void BM_BoxTest(benchmark::State& state) {
+  const SceneCase& c = cases().front();
+  const RayBoxTest box(c.rays.primary[c.rays.primary.size() / 2]);
+  const auto& nodes = c.bvh->nodes();
+  float acc = 0;
+  for (auto _ : state) {
+    for (const BvhNode& n : nodes) acc += box.enter(n.lo, n.hi, 0.0f, kInfinity) == kInfinity ? 0.0f : 1.0f;
+  }
+  benchmark::DoNotOptimize(acc);
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(nodes.size()));
+}
+BENCHMARK(BM_BoxTest);
+
+void register_dynamic() {
+  for (SceneCase& c : cases()) {
+    for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
+      for (BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+        static const char* modes[] = {"seq", "async", "queue", "tasks"};
+        const std::string name = std::string("BM_BvhBuild/") + c.name + "/" + (split == BvhSplit::Sah ? "sah/" : "median/") + modes[int(mode)];
+        benchmark::RegisterBenchmark(name.c_str(), [&c, split, mode](benchmark::State& st) {
+          BvhBuildOptions o;
+          o.split = split;
+          o.mode = mode;
+          size_t bytes = 0;
+          for (auto _ : st) {
+            const Bvh bvh(*c.scene, o);
+            bytes = bvh.memory_bytes();
+            benchmark::DoNotOptimize(bvh.nodes().data());
+          }
+          st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+          st.counters["bytes/tri"] = double(bytes) / double(c.scene->size());
+        })->Unit(benchmark::kMillisecond);
+      }
+    }
+    if (embree_available()) {
+      benchmark::RegisterBenchmark((std::string("BM_BvhBuild/") + c.name + "/embree").c_str(), [&c](benchmark::State& st) {
+        for (auto _ : st) benchmark::DoNotOptimize(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}).impl.get());
+        st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+      })->Unit(benchmark::kMillisecond);
+    }
+    std::vector<std::pair<std::string, AccelOptions>> accels = {{"bvh-sah", AccelOptions{}}};
+    AccelOptions median;
+    median.bvh.split = BvhSplit::Median;
+    accels.emplace_back("bvh-median", median);
+    if (embree_available()) accels.emplace_back("embree", AccelOptions{.kind = AccelKind::Embree});
+    for (const auto& [accel_name, options] : accels) {
+      auto accel = std::make_shared<Accelerator>(build_accelerator(*c.scene, options));
+      for (int kind = 0; kind < 3; ++kind) {
+        static const char* kinds[] = {"primary", "shadow", "ao"};
+        const std::vector<Ray>* rays = kind == 0 ? &c.rays.primary : (kind == 1 ? &c.rays.shadow : &c.rays.ao);
+        if (rays->empty()) continue;
+        const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind];
+        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, kind](benchmark::State& st) {
+          size_t n = 0;
+          accel->visit([&](const auto& a) {
+            Hit h;
+            for (auto _ : st) {
+              for (const Ray& r : *rays) n += kind == 0 ? a.intersect(r, h) : a.occluded(r);
+            }
+          });
+          benchmark::DoNotOptimize(n);
+          st.counters["Mrays/s"] = benchmark::Counter(double(rays->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+        })->Unit(benchmark::kMillisecond);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tracer
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  tracer::register_dynamic();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,407 @@
+#include "cli/bench.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "accel/accelerator.hpp"
+#include "cli/parse.hpp"
+#include "io/image_io.hpp"
+#include "render/shading.hpp"
+#include "sched/scheduler.hpp"
+#include "scene/builtin.hpp"
+#include "scene/camera.hpp"
+#include "scene/errors.hpp"
+#include "scene/obj_loader.hpp"
+
+namespace tracer::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Variant {
+  std::string name;
+  AccelKind accel;
+  BvhSplit split;
+  BuildMode build;
+  SchedKind sched;
+  std::string description;
+  bool study;
+};
+
+// The study's ten columns (its ISPC column waits for the SIMD kernels) and ours.
+const std::vector<Variant>& all_variants() {
+  static const std::vector<Variant> v = {
+      {"seq", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq, "brute force, one thread", true},
+      {"async", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Async, "brute force, std::async per row", true},
+      {"bvh", AccelKind::Bvh, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq, "median BVH, one thread", true},
+      {"async+bvh", AccelKind::Bvh, BvhSplit::Median, BuildMode::Seq, SchedKind::Async, "median BVH, async rows", true},
+      {"async+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Async, "median BVH built with std::async, async rows", true},
+      {"lq+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Queue, "median BVH built with std::async, locked queue", true},
+      {"async+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Async, "median BVH built by a job queue, async rows", true},
+      {"lq+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Queue, "median BVH built by a job queue, locked queue", true},
+      {"lq", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Queue, "brute force, locked queue", true},
+      {"sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Seq, SchedKind::Seq, "SAH BVH, one thread", false},
+      {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic, "SAH BVH (TBB build), atomic tile counter", false},
+      {"best", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
+      {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "Intel Embree 3, TBB work stealing", false},
+  };
+  return v;
+}
+
+// The study's published milliseconds (4-core i7-7700HQ), for ratio comparison.
+const std::map<std::string, std::map<std::string, double>>& study_ms() {
+  static const std::map<std::string, std::map<std::string, double>> m = {
+      {"Original", {{"seq", 9867.0}, {"async", 2271.0}, {"bvh", 4043.3}, {"async+bvh", 1034.0}, {"async+bvh+parbuild-v1", 1047.7}, {"lq+bvh+parbuild-v1", 1244.3}, {"async+bvh+parbuild-v2", 958.3}, {"lq+bvh+parbuild-v2", 1254.3}, {"lq", 2714.0}}},
+      {"Mirror", {{"seq", 9865.0}, {"async", 2271.3}, {"bvh", 4037.0}, {"async+bvh", 1030.7}, {"async+bvh+parbuild-v1", 1052.7}, {"lq+bvh+parbuild-v1", 1243.3}, {"async+bvh+parbuild-v2", 958.7}, {"lq+bvh+parbuild-v2", 1253.0}, {"lq", 2713.0}}},
+      {"Sphere", {{"seq", 463005.0}, {"async", 116098.0}, {"bvh", 3708.0}, {"async+bvh", 1078.0}, {"async+bvh+parbuild-v1", 1131.0}, {"lq+bvh+parbuild-v1", 1182.7}, {"async+bvh+parbuild-v2", 1016.3}, {"lq+bvh+parbuild-v2", 1147.3}, {"lq", 129371.3}}},
+      {"Water", {{"seq", 1482647.0}, {"async", 373939.0}, {"bvh", 4489.0}, {"async+bvh", 1528.3}, {"async+bvh+parbuild-v1", 1747.7}, {"lq+bvh+parbuild-v1", 1638.0}, {"async+bvh+parbuild-v2", 1607.7}, {"lq+bvh+parbuild-v2", 1512.7}, {"lq", 417250.3}}},
+  };
+  return m;
+}
+
+struct SceneEntry {
+  std::string name, path;
+};
+
+std::string shared_scenes_dir() {
+  // From the project root or its build directory: ../shared/scenes.
+  for (const char* p : {"../shared/scenes", "../../shared/scenes", "../../../shared/scenes"}) {
+    if (std::filesystem::exists(std::string(p) + "/cornell-box")) return p;
+  }
+  return "../shared/scenes";
+}
+
+std::vector<SceneEntry> resolve_scenes(const std::string& spec) {
+  const std::string dir = shared_scenes_dir();
+  std::vector<SceneEntry> out;
+  std::stringstream ss(spec);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (item == "cornell" || item == "all") {
+      for (const char* n : {"Original", "Mirror", "Sphere", "Water"}) out.push_back({n, dir + "/cornell-box/CornellBox-" + n + ".obj"});
+    }
+    if (item == "large" || item == "all") {
+      out.push_back({"Sponza", dir + "/sponza/sponza.obj"});
+      out.push_back({"Sibenik", dir + "/sibenik/sibenik.obj"});
+      out.push_back({"Bunny", dir + "/bunny/bunny.obj"});
+    }
+    if (item == "builtin") out.push_back({"builtin", ""});
+    if (item != "cornell" && item != "large" && item != "all" && item != "builtin") {
+      std::string name = std::filesystem::path(item).stem().string();
+      if (name.rfind("CornellBox-", 0) == 0) name = name.substr(11);  // the study's scene names
+      out.push_back({name, item});
+    }
+  }
+  if (out.empty()) throw UsageError("--scenes: no scenes named");
+  return out;
+}
+
+std::vector<Variant> resolve_variants(const std::string& spec) {
+  std::vector<Variant> out;
+  std::stringstream ss(spec);
+  for (std::string item; std::getline(ss, item, ',');) {
+    bool found = false;
+    for (const Variant& v : all_variants()) {
+      const bool group = item == "all" || (item == "study" && v.study) || (item == "ours" && !v.study);
+      if (group || v.name == item) {
+        if (v.accel == AccelKind::Embree && !embree_available()) {
+          if (item == v.name) throw UsageError("--variants: 'embree' needs a build with Embree");
+          continue;
+        }
+        out.push_back(v);
+        found = true;
+      }
+    }
+    if (!found) throw UsageError("--variants: unknown variant '" + item + "' (see tracer bench --list)");
+  }
+  return out;
+}
+
+struct Cell {
+  std::string scene, variant;
+  bool timed_out = false;
+  double load_ms = 0, build_ms = 0, render_ms = 0, total_ms = 0;  // k-best means
+  uint64_t rays = 0;
+  double mrays = 0;
+  size_t triangles = 0;
+  std::vector<double> run_ms;
+};
+
+double kbest_mean(std::vector<double> v, int best) {
+  std::sort(v.begin(), v.end());
+  const size_t k = std::min<size_t>(size_t(best), v.size());
+  return k ? std::accumulate(v.begin(), v.begin() + long(k), 0.0) / double(k) : 0.0;
+}
+
+std::string fmt(double v, int prec = 1) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", prec, v);
+  return b;
+}
+
+// Stops a render after `seconds` through the scheduler's cancel flag.
+class Watchdog {
+ public:
+  Watchdog(std::atomic<bool>& flag, double seconds) : flag_(flag) {
+    thread_ = std::thread([this, seconds] {
+      std::unique_lock lock(m_);
+      if (!cv_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) flag_ = true;
+    });
+  }
+  ~Watchdog() {
+    {
+      std::lock_guard lock(m_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool>& flag_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+std::string svg_chart(const std::vector<SceneEntry>& scenes, const std::vector<Variant>& variants,
+                      const std::map<std::pair<std::string, std::string>, Cell>& cells) {
+  // Grouped bars, log scale of total milliseconds; one group per scene, one colour per variant.
+  const int bar = 10, gap = 24, left = 70, top = 30, height = 300;
+  const int group = int(variants.size()) * bar + gap;
+  const int width = left + int(scenes.size()) * group + 260;
+  double lo = 1e30, hi = 0;
+  for (const auto& [k, c] : cells) {
+    if (c.timed_out || c.total_ms <= 0) continue;
+    lo = std::min(lo, c.total_ms);
+    hi = std::max(hi, c.total_ms);
+  }
+  if (hi <= 0) return "";
+  const double l0 = std::floor(std::log10(lo)), l1 = std::ceil(std::log10(hi)) + (lo == hi ? 1 : 0);
+  const auto y_of = [&](double ms) { return top + height - int((std::log10(ms) - l0) / (l1 - l0) * height); };
+  std::ostringstream s;
+  s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width << "' height='" << top + height + 60
+    << "' font-family='sans-serif' font-size='11'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  for (double e = l0; e <= l1; e += 1) {
+    const int y = y_of(std::pow(10.0, e));
+    s << "<line x1='" << left << "' x2='" << left + int(scenes.size()) * group << "' y1='" << y << "' y2='" << y << "' stroke='#ddd'/>"
+      << "<text x='" << left - 6 << "' y='" << y + 4 << "' text-anchor='end'>" << fmt(std::pow(10.0, e), 0) << " ms</text>\n";
+  }
+  for (size_t si = 0; si < scenes.size(); ++si) {
+    const int gx = left + int(si) * group + gap / 2;
+    for (size_t vi = 0; vi < variants.size(); ++vi) {
+      const auto it = cells.find({scenes[si].name, variants[vi].name});
+      if (it == cells.end() || it->second.timed_out || it->second.total_ms <= 0) continue;
+      const int y = y_of(it->second.total_ms);
+      s << "<rect x='" << gx + int(vi) * bar << "' y='" << y << "' width='" << bar - 1 << "' height='" << top + height - y
+        << "' fill='hsl(" << (vi * 360 / variants.size()) << ",60%,50%)'><title>" << variants[vi].name << " on " << scenes[si].name
+        << ": " << fmt(it->second.total_ms) << " ms</title></rect>\n";
+    }
+    s << "<text x='" << gx + int(variants.size()) * bar / 2 << "' y='" << top + height + 16 << "' text-anchor='middle'>" << scenes[si].name << "</text>\n";
+  }
+  for (size_t vi = 0; vi < variants.size(); ++vi) {
+    const int x = left + int(scenes.size()) * group + 20, y = top + int(vi) * 16;
+    s << "<rect x='" << x << "' y='" << y << "' width='10' height='10' fill='hsl(" << (vi * 360 / variants.size()) << ",60%,50%)'/>"
+      << "<text x='" << x + 16 << "' y='" << y + 9 << "'>" << variants[vi].name << "</text>\n";
+  }
+  s << "<text x='" << left << "' y='16' font-size='13'>tracer bench: build + render time per scene and variant (log scale, k-best mean)</text>\n</svg>\n";
+  return s.str();
+}
+
+}  // namespace
+
+void add_bench_options(CLI::App& app, BenchArgs& a) {
+  app.add_option("--variants", a.variants, "variants: names, or study, ours, all")->capture_default_str();
+  app.add_option("--scenes", a.scenes, "scenes: OBJ paths, builtin, or cornell, large, all")->capture_default_str();
+  app.add_option("--size", a.size, "image size WxH")->capture_default_str();
+  app.add_option("--ao", a.ao, "AO rays per hit")->capture_default_str();
+  app.add_option("--runs", a.runs, "timed runs per cell")->capture_default_str();
+  app.add_option("--best", a.best, "mean of the best k runs (the study's k-best rule)")->capture_default_str();
+  app.add_option("--threads", a.threads, "threads for the parallel variants (default: all)");
+  app.add_option("--max-seconds", a.max_seconds, "stop a cell whose run exceeds this")->capture_default_str();
+  app.add_option("--json", a.json, "write raw figures as JSON");
+  app.add_option("--plot", a.plot, "write a grouped bar chart (SVG, log scale)");
+  app.add_option("--markdown", a.markdown, "also write the tables to this Markdown file");
+  app.add_flag("--list", a.list, "list the variants and exit");
+}
+
+int run_bench(const BenchArgs& a) {
+  if (a.list) {
+    for (const Variant& v : all_variants()) std::printf("%-24s %s%s\n", v.name.c_str(), v.description.c_str(), v.study ? " (study)" : "");
+    return 0;
+  }
+  int width = 0, height = 0;
+  if (std::sscanf(a.size.c_str(), "%dx%d", &width, &height) != 2) throw UsageError("--size: expected WxH, got '" + a.size + "'");
+  check_range("--size width", width, 1, 16384);
+  check_range("--size height", height, 1, 16384);
+  check_range("--ao", a.ao, 0, 4096);
+  check_range("--runs", a.runs, 1, 1000);
+  check_range("--best", a.best, 1, a.runs);
+  if (a.threads != 0) check_range("--threads", a.threads, 1, 1024);
+  check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, true);
+  const std::vector<Variant> variants = resolve_variants(a.variants);
+  const std::vector<SceneEntry> scenes = resolve_scenes(a.scenes);
+  for (const std::string* out : {&a.json, &a.plot, &a.markdown}) {
+    if (!out->empty()) check_writable(*out);
+  }
+
+  std::map<std::pair<std::string, std::string>, Cell> cells;
+  const size_t total_cells = variants.size() * scenes.size();
+  size_t done_cells = 0;
+  const auto bench_start = Clock::now();
+  const bool tty = ::isatty(STDERR_FILENO);
+  for (const SceneEntry& se : scenes) {
+    const auto t_load = Clock::now();
+    const Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
+    const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_load).count();
+    const CameraSpec cam = scene.camera ? *scene.camera : frame_bounds(scene.bounds);
+    for (const Variant& v : variants) {
+      Cell cell;
+      cell.scene = se.name;
+      cell.variant = v.name;
+      cell.triangles = scene.size();
+      cell.load_ms = load_ms;
+      std::vector<double> builds, renders;
+      for (int run = 0; run < a.runs && !cell.timed_out; ++run) {
+        if (tty || run == 0) {  // logs get one line per cell
+        const double elapsed = std::chrono::duration<double>(Clock::now() - bench_start).count();
+        const double frac = (double(done_cells) + double(run) / a.runs) / double(total_cells);
+        std::fprintf(stderr, "%scell %zu/%zu %-10s %-24s run %2d/%d  elapsed %6.0fs  ETA %s%s", tty ? "\r" : "", done_cells + 1, total_cells,
+                     se.name.c_str(), v.name.c_str(), run + 1, a.runs, elapsed,
+                     frac > 0 ? (fmt(elapsed * (1 - frac) / frac, 0) + "s").c_str() : "?", tty ? "   " : "\n");
+        }
+        AccelOptions ao;
+        ao.kind = v.accel;
+        ao.bvh.split = v.split;
+        ao.bvh.mode = v.build;
+        ao.bvh.threads = a.threads;
+        const Accelerator accel = build_accelerator(scene, ao);
+        RenderSettings rs;
+        rs.width = width;
+        rs.height = height;
+        rs.ao_samples = a.ao;
+        Framebuffer fb(width, height);
+        RenderContext ctx{&scene, Camera(cam, width, height), rs, &fb};
+        std::atomic<bool> stop{false};
+        RenderControl control;
+        control.cancel = &stop;
+        SchedOptions so;
+        so.kind = v.sched;
+        so.threads = a.threads;
+        const auto t0 = Clock::now();
+        bool finished;
+        {
+          Watchdog watchdog(stop, std::max(0.0, a.max_seconds - accel.build_ms / 1000.0));
+          finished = render_image(accel, ctx, so, control);
+        }
+        const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        if (!finished) {
+          cell.timed_out = true;
+          break;
+        }
+        builds.push_back(accel.build_ms);
+        renders.push_back(render_ms);
+        cell.run_ms.push_back(accel.build_ms + render_ms);
+        cell.rays = control.counts.load().total();
+      }
+      if (!cell.timed_out) {
+        cell.build_ms = kbest_mean(builds, a.best);
+        cell.render_ms = kbest_mean(renders, a.best);
+        cell.total_ms = kbest_mean(cell.run_ms, a.best);
+        cell.mrays = cell.render_ms > 0 ? double(cell.rays) / (cell.render_ms * 1e3) : 0;
+      }
+      cells[{se.name, v.name}] = cell;
+      ++done_cells;
+    }
+  }
+  if (tty) std::fprintf(stderr, "\r%100s\r", "");
+
+  // Tables.
+  std::ostringstream md;
+  const auto header = [&](const std::string& title) {
+    md << "\n### " << title << "\n\n| scene | triangles |";
+    for (const Variant& v : variants) md << " " << v.name << " |";
+    md << "\n|---|---:|";
+    for (size_t i = 0; i < variants.size(); ++i) md << "---:|";
+    md << "\n";
+  };
+  const auto row = [&](const auto& value_of) {
+    for (const SceneEntry& se : scenes) {
+      md << "| " << se.name << " | " << cells[{se.name, variants[0].name}].triangles << " |";
+      for (const Variant& v : variants) md << " " << value_of(se, v, cells[{se.name, v.name}]) << " |";
+      md << "\n";
+    }
+  };
+  const std::string timeout_text = "> " + fmt(a.max_seconds, 0) + " s";
+  md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs << " runs, mean of best " << a.best
+     << ", threads " << (a.threads ? std::to_string(a.threads) : std::to_string(resolve_thread_count(0))) << "\n";
+  header("Build + render time, ms (k-best mean)");
+  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? timeout_text : fmt(c.total_ms); });
+  header("Build time, ms");
+  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? std::string("-") : fmt(c.build_ms, 2); });
+  header("Throughput, Mrays/s (render only)");
+  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? std::string("-") : fmt(c.mrays, 2); });
+  const bool have_seq = std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "seq"; });
+  if (have_seq) {
+    header("Speedup over seq (same scene, same run)");
+    row([&](const SceneEntry& se, const Variant&, const Cell& c) {
+      const Cell& s = cells[{se.name, "seq"}];
+      if (c.timed_out || s.timed_out) return std::string("-");
+      return fmt(s.total_ms / c.total_ms, 2) + "x";
+    });
+    header("Study comparison: speedup over seq, ours / study's");
+    row([&](const SceneEntry& se, const Variant& v, const Cell& c) {
+      const auto sit = study_ms().find(se.name);
+      const Cell& s = cells[{se.name, "seq"}];
+      if (sit == study_ms().end() || !sit->second.count(v.name) || c.timed_out || s.timed_out) return std::string("-");
+      const double study_speedup = sit->second.at("seq") / sit->second.at(v.name);
+      return fmt(s.total_ms / c.total_ms, 1) + " / " + fmt(study_speedup, 1);
+    });
+  }
+  const bool have_embree = std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "embree"; });
+  if (have_embree) {
+    header("Throughput relative to Embree (Mrays/s ratio, same rays, same run)");
+    row([&](const SceneEntry& se, const Variant&, const Cell& c) {
+      const Cell& e = cells[{se.name, "embree"}];
+      if (c.timed_out || e.timed_out || e.mrays <= 0) return std::string("-");
+      return fmt(c.mrays / e.mrays, 2) + "x";
+    });
+  }
+  std::cout << md.str();
+  if (!a.markdown.empty()) write_file_atomic(a.markdown, md.str());
+  if (!a.json.empty()) {
+    std::ostringstream j;
+    j << "{\n  \"size\": [" << width << ", " << height << "], \"ao\": " << a.ao << ", \"runs\": " << a.runs << ", \"best\": " << a.best
+      << ",\n  \"cells\": [\n";
+    bool first = true;
+    for (const auto& [key, c] : cells) {
+      j << (first ? "" : ",\n") << "    {\"scene\": \"" << c.scene << "\", \"variant\": \"" << c.variant << "\", \"triangles\": " << c.triangles
+        << ", \"timed_out\": " << (c.timed_out ? "true" : "false") << ", \"load_ms\": " << c.load_ms << ", \"build_ms\": " << c.build_ms
+        << ", \"render_ms\": " << c.render_ms << ", \"total_ms\": " << c.total_ms << ", \"rays\": " << c.rays << ", \"mrays_per_s\": " << c.mrays
+        << ", \"runs_ms\": [";
+      for (size_t i = 0; i < c.run_ms.size(); ++i) j << (i ? ", " : "") << c.run_ms[i];
+      j << "]}";
+      first = false;
+    }
+    j << "\n  ]\n}\n";
+    write_file_atomic(a.json, j.str());
+  }
+  if (!a.plot.empty()) write_file_atomic(a.plot, svg_chart(scenes, variants, cells));
+  return 0;
+}
+
+}  // namespace tracer::cli

@@ -1,0 +1,27 @@
+// `tracer bench`: the study's variants and ours over a set of scenes, timed the study's way
+// (k-best: mean of the best `best` of `runs` runs), with ray counts, Mrays/s and Embree ratios.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace tracer::cli {
+
+struct BenchArgs {
+  std::string variants = "study";  // comma list of names, or "study", "ours", "all"
+  std::string scenes = "cornell";  // comma list of paths/names, or "cornell", "large", "all"
+  std::string size = "256x256";
+  int ao = 16;
+  int runs = 10, best = 3;
+  int threads = 0;
+  double max_seconds = 60.0;
+  std::string json, plot, markdown;
+  bool list = false;
+};
+
+void add_bench_options(CLI::App& app, BenchArgs& args);
+int run_bench(const BenchArgs& args);
+
+}  // namespace tracer::cli
