@@ -122,14 +122,14 @@ void register_dynamic() {
           }
           st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
           st.counters["bytes/tri"] = double(bytes) / double(c.scene->size());
-        })->Unit(benchmark::kMillisecond);
+        })->Unit(benchmark::kMillisecond)->UseRealTime();
       }
     }
     if (embree_available()) {
       benchmark::RegisterBenchmark((std::string("BM_BvhBuild/") + c.name + "/embree").c_str(), [&c](benchmark::State& st) {
         for (auto _ : st) benchmark::DoNotOptimize(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}).impl.get());
         st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-      })->Unit(benchmark::kMillisecond);
+      })->Unit(benchmark::kMillisecond)->UseRealTime();
     }
     std::vector<std::pair<std::string, AccelOptions>> accels = {{"bvh-sah", AccelOptions{}}};
     AccelOptions median;

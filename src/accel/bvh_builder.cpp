@@ -30,7 +30,7 @@ constexpr uint32_t kParallelSubtree = 4096;   // below this a subtree is built b
 constexpr uint32_t kParallelSplit = 65536;    // above this one node's passes run in parallel (tasks)
 constexpr uint32_t kPartitionBlock = 16384;   // block size of the parallel stable partition
 constexpr uint32_t kMedianFallbackDepth = 64; // SAH switches to object median below this depth
-constexpr int kMaxBins = 64;
+constexpr int kMaxBins = 32;
 
 struct BuildNode {
   Aabb box;
@@ -39,9 +39,9 @@ struct BuildNode {
   uint32_t depth = 0;
 };
 
-struct Bin {
-  Aabb box;
-  uint32_t count = 0;
+// A triangle's box padded to four lanes for the binning loop.
+struct alignas(32) Box4 {
+  float lo[4], hi[4];
 };
 
 struct Bounds2 {
@@ -66,9 +66,11 @@ class BvhBuilder {
     }
     boxes_.resize(scene.size());
     centroids_.resize(scene.size());
+    box4_.resize(scene.size());
     for (uint32_t i : prims_) {
       boxes_[i] = scene.triangles[i].bounds();
       centroids_[i] = boxes_[i].center();  // box centre, not vertex mean: it is what binning sees
+      box4_[i] = Box4{{boxes_[i].lo.x, boxes_[i].lo.y, boxes_[i].lo.z, 0.0f}, {boxes_[i].hi.x, boxes_[i].hi.y, boxes_[i].hi.z, 0.0f}};
     }
     scratch_.resize(prims_.size());
     nodes_.resize(std::max<size_t>(1, 2 * prims_.size()));
@@ -236,10 +238,21 @@ class BvhBuilder {
     BuildNode& node = nodes_[id];
     const uint32_t begin = node.begin, end = node.end, count = end - begin;
     const Bounds2 bounds = reduce_range(begin, end, parallel, Bounds2{}, [&](uint32_t b, uint32_t e, Bounds2 acc) {
+      // Four-lane accumulators (vectorised min/max); centroid = (lo + hi) / 2 lane-wise.
+      float lo[4], hi[4], clo[4], chi[4];
+      for (int k = 0; k < 4; ++k) { lo[k] = clo[k] = kInfinity; hi[k] = chi[k] = -kInfinity; }
       for (uint32_t i = b; i < e; ++i) {
-        acc.box.extend(boxes_[prims_[i]]);
-        acc.centroids.extend(centroids_[prims_[i]]);
+        const Box4& box = box4_[prims_[i]];
+        for (int k = 0; k < 4; ++k) {
+          const float c = (box.lo[k] + box.hi[k]) * 0.5f;
+          lo[k] = box.lo[k] < lo[k] ? box.lo[k] : lo[k];
+          hi[k] = box.hi[k] > hi[k] ? box.hi[k] : hi[k];
+          clo[k] = c < clo[k] ? c : clo[k];
+          chi[k] = c > chi[k] ? c : chi[k];
+        }
       }
+      acc.box.extend(Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
+      acc.centroids.extend(Aabb{{clo[0], clo[1], clo[2]}, {chi[0], chi[1], chi[2]}});
       return acc;
     });
     node.box = bounds.box;
@@ -262,8 +275,9 @@ class BvhBuilder {
         } else {
           const float leaf_cost = options_.intersection_cost * float(count);
           if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
+          const Binner binner(bounds.centroids, sah.bins);
           mid = partition(begin, end, parallel, [&](uint32_t prim) {
-            return bin_of(centroids_[prim][sah.axis], bounds.centroids, sah.axis) < sah.split_bin;
+            return binner(centroids_[prim][sah.axis], sah.axis) < sah.split_bin;
           });
         }
       }
@@ -285,65 +299,106 @@ class BvhBuilder {
     return mid;
   }
 
-  int bin_of(float c, const Aabb& cbox, int axis) const {
-    const float scale = float(options_.bins) / (cbox.hi[axis] - cbox.lo[axis]);
-    const int b = static_cast<int>((c - cbox.lo[axis]) * scale);
-    return std::clamp(b, 0, options_.bins - 1);
-  }
+  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; int bins = 0; };
 
-  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; };
+  // Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
+  // initialised, which matters because most nodes are small.
+  // Four lanes (the fourth unused) so each min/max below compiles to one SSE instruction.
+  struct alignas(16) RawBin {
+    float lo[4], hi[4];
+    uint32_t count;
+    void reset() {
+      for (int k = 0; k < 4; ++k) { lo[k] = kInfinity; hi[k] = -kInfinity; }
+      count = 0;
+    }
+    void add(const Box4& b) {
+      for (int k = 0; k < 4; ++k) lo[k] = b.lo[k] < lo[k] ? b.lo[k] : lo[k];
+      for (int k = 0; k < 4; ++k) hi[k] = b.hi[k] > hi[k] ? b.hi[k] : hi[k];
+      ++count;
+    }
+    void add(const RawBin& o) {
+      for (int k = 0; k < 4; ++k) lo[k] = o.lo[k] < lo[k] ? o.lo[k] : lo[k];
+      for (int k = 0; k < 4; ++k) hi[k] = o.hi[k] > hi[k] ? o.hi[k] : hi[k];
+      count += o.count;
+    }
+    Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+  };
 
   struct BinSet {
-    Bin bins[3][kMaxBins];
+    int nb;
+    RawBin bins[3][kMaxBins];
+    explicit BinSet(int n) : nb(n) {
+      for (auto& axis : bins) for (int b = 0; b < nb; ++b) axis[b].reset();
+    }
     void join(const BinSet& o) {
+      for (int a = 0; a < 3; ++a) for (int b = 0; b < nb; ++b) bins[a][b].add(o.bins[a][b]);
+    }
+  };
+
+  // Maps a centroid coordinate to its bin: precomputed offset and scale, no division per primitive.
+  struct Binner {
+    float lo[3], scale[3];
+    int nb;
+    Binner(const Aabb& cbox, int bins) : nb(bins) {
       for (int a = 0; a < 3; ++a) {
-        for (int b = 0; b < kMaxBins; ++b) {
-          bins[a][b].box.extend(o.bins[a][b].box);
-          bins[a][b].count += o.bins[a][b].count;
-        }
+        lo[a] = cbox.lo[a];
+        const float extent = cbox.hi[a] - cbox.lo[a];
+        scale[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
       }
+    }
+    int operator()(float c, int axis) const {
+      return std::clamp(static_cast<int>((c - lo[axis]) * scale[axis]), 0, nb - 1);
     }
   };
 
   SahChoice sah_split(const BuildNode& node, const Aabb& cbox, bool parallel) const {
-    const int nb = options_.bins;
-    const BinSet bins = reduce_range(node.begin, node.end, parallel, BinSet{}, [&](uint32_t b, uint32_t e, BinSet acc) {
+    // Fewer bins than primitives buy nothing: small nodes use fewer.
+    const int nb = std::clamp(int(node.end - node.begin), 4, options_.bins);
+    const Binner binner(cbox, nb);
+    const auto fill = [&](uint32_t b, uint32_t e, BinSet& acc) {
       for (uint32_t i = b; i < e; ++i) {
         const uint32_t p = prims_[i];
-        for (int a = 0; a < 3; ++a) {
-          if (cbox.hi[a] <= cbox.lo[a]) continue;
-          Bin& bin = acc.bins[a][bin_of(centroids_[p][a], cbox, a)];
-          bin.box.extend(boxes_[p]);
-          ++bin.count;
-        }
+        const Vec3 c = centroids_[p];
+        const Box4& box = box4_[p];
+        acc.bins[0][binner(c.x, 0)].add(box);
+        acc.bins[1][binner(c.y, 1)].add(box);
+        acc.bins[2][binner(c.z, 2)].add(box);
       }
-      return acc;
-    });
+    };
+    // Sequentially the bins are filled in place: a BinSet is kilobytes, and copying it per node
+    // used to cost more than the binning itself.
+    BinSet bins(nb);
+    if (parallel) {
+      bins = reduce_range(node.begin, node.end, true, BinSet(nb), [&](uint32_t b, uint32_t e, BinSet acc) {
+        fill(b, e, acc);
+        return acc;
+      });
+    } else {
+      fill(node.begin, node.end, bins);
+    }
     SahChoice best;
     best.cost = kInfinity;
     const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
     for (int a = 0; a < 3; ++a) {
       if (cbox.hi[a] <= cbox.lo[a]) continue;
       float right_cost[kMaxBins];  // area * count of bins [s, nb)
-      Aabb acc;
-      uint32_t n = 0;
+      RawBin acc;
+      acc.reset();
       for (int s = nb - 1; s > 0; --s) {
-        acc.extend(bins.bins[a][s].box);
-        n += bins.bins[a][s].count;
-        right_cost[s] = n ? acc.half_area() * float(n) : kInfinity;
+        acc.add(bins.bins[a][s]);
+        right_cost[s] = acc.count ? acc.box().half_area() * float(acc.count) : kInfinity;
       }
-      acc = Aabb{};
-      n = 0;
+      acc.reset();
       for (int s = 1; s < nb; ++s) {
-        acc.extend(bins.bins[a][s - 1].box);
-        n += bins.bins[a][s - 1].count;
-        if (n == 0) continue;
+        acc.add(bins.bins[a][s - 1]);
+        if (acc.count == 0) continue;
         const float cost = options_.traversal_cost +
-                           options_.intersection_cost * (acc.half_area() * float(n) + right_cost[s]) * inv_area;
+                           options_.intersection_cost * (acc.box().half_area() * float(acc.count) + right_cost[s]) * inv_area;
         if (cost < best.cost) best = {a, s, cost};
       }
     }
     if (!(best.cost < kInfinity)) best.axis = -1;
+    best.bins = nb;
     return best;
   }
 
@@ -397,6 +452,7 @@ class BvhBuilder {
   BvhBuildOptions options_;
   std::vector<uint32_t> prims_, scratch_;
   std::vector<Aabb> boxes_;
+  std::vector<Box4> box4_;
   std::vector<Vec3> centroids_;
   std::vector<BuildNode> nodes_;
   std::atomic<uint32_t> node_count_{0};

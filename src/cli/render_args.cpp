@@ -33,7 +33,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--bvh-split", a.split, "BVH split: sah or median (the study's)")->capture_default_str();
   app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
   app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
-  app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-64)")->capture_default_str();
+  app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
@@ -63,7 +63,7 @@ void validate(const RenderArgs& a) {
   check_range("--tile", a.tile, 1, 4096);
   check_range("--block", a.block, 1, 1 << 20);
   check_range("--max-leaf", a.max_leaf, 1, 16);
-  check_range("--bins", a.bins, 4, 64);
+  check_range("--bins", a.bins, 4, 32);
   if (!a.eye.empty()) parse_vec3("--eye", a.eye);
   if (!a.look.empty()) parse_vec3("--look", a.look);
   if (!a.up.empty()) {
