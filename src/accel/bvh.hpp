@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,21 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32);
 
+// Cache-line aligned storage: with sibling pairs at even indices, each pair is one 64-byte line.
+template <class T>
+struct CacheAlignedAllocator {
+  using value_type = T;
+  CacheAlignedAllocator() = default;
+  template <class U>
+  CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
+  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
+  void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t{64}); }
+  template <class U>
+  bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+};
+
+using BvhNodeArray = std::vector<BvhNode, CacheAlignedAllocator<BvhNode>>;
+
 struct BvhStats {
   size_t nodes = 0, leaves = 0, max_depth = 0, max_leaf_size = 0;
   double sah_cost = 0.0;  // expected cost per ray, in the builder's cost units
@@ -51,7 +67,8 @@ class Bvh {
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
 
-  const std::vector<BvhNode>& nodes() const { return nodes_; }
+  // nodes()[0] is the root; nodes()[1] is padding so sibling pairs start at even indices.
+  const BvhNodeArray& nodes() const { return nodes_; }
   const std::vector<Triangle>& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }  // scene index per slot
   const BvhBuildOptions& options() const { return options_; }
@@ -66,7 +83,7 @@ class Bvh {
  private:
   const Scene* scene_;
   BvhBuildOptions options_;
-  std::vector<BvhNode> nodes_;
+  BvhNodeArray nodes_;
   std::vector<Triangle> tris_;
   std::vector<uint32_t> ids_;
 };

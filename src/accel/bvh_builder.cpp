@@ -95,11 +95,12 @@ class BvhBuilder {
   }
 
   // Depth-first flattening into the final layout: children adjacent, leaves pointing into prims_.
-  void flatten(std::vector<BvhNode>& out) const {
+  void flatten(BvhNodeArray& out) const {
     out.clear();
     if (prims_.empty()) return;
-    out.reserve(node_count_.load());
+    out.reserve(node_count_.load() + 1);
     out.push_back({});
+    out.push_back(BvhNode{{}, 0, {}, 0});  // padding: children pairs start at even indices
     struct Item { uint32_t build, flat; };
     std::vector<Item> stack{{0, 0}};
     while (!stack.empty()) {

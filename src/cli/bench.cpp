@@ -55,6 +55,8 @@ const std::vector<Variant>& all_variants() {
       {"lq+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Queue, "median BVH built by a job queue, locked queue", true},
       {"lq", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Queue, "brute force, locked queue", true},
       {"sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Seq, SchedKind::Seq, "SAH BVH, one thread", false},
+      {"async+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Async, "SAH BVH (TBB build), std::async per row", false},
+      {"lq+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Queue, "SAH BVH (TBB build), locked queue of 64-pixel blocks", false},
       {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic, "SAH BVH (TBB build), atomic tile counter", false},
       {"best", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
       {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "Intel Embree 3, TBB work stealing", false},
