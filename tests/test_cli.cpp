@@ -2,6 +2,10 @@
 // image left behind by a failed run.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -118,6 +122,35 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   EXPECT_NE(r.output.find("triangles   1"), std::string::npos) << r.output;
   r = test::run_tracer("--help");
   EXPECT_EQ(r.exit_code, 0);
+}
+
+TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
+  // A brute-force render of a few thousand triangles at 2048x2048 runs for minutes; SIGINT after
+  // half a second must end it within a fraction of a second with exit code 130.
+  const std::string scene = dir_ + "/many.obj";
+  {
+    std::ofstream f(scene);
+    for (int i = 0; i < 2000; ++i) f << "v " << i % 50 << " " << i / 50 << " 0\n";
+    for (int i = 1; i + 51 <= 2000; ++i) f << "f " << i << " " << i + 1 << " " << i + 50 << "\n";
+  }
+  const std::string exe = TRACER_EXE;
+  for (const bool partial : {false, true}) {
+    const std::string out = dir_ + (partial ? "/partial.png" : "/none.png");
+    const std::string cmd = "timeout --preserve-status -s INT 0.5 " + exe + " render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out +
+                            (partial ? " --save-partial" : "") + " 2>&1";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int status = std::system(cmd.c_str());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_LT(seconds, 30.0);  // a generous bound: without the handler this render takes minutes
+    EXPECT_EQ(fs::exists(out), partial);
+    if (partial) {
+      const Image8 img = read_image(out);
+      EXPECT_EQ(img.width, 2048);
+    }
+  }
+  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
 }
 
 }  // namespace

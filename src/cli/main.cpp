@@ -77,6 +77,11 @@ int cmd_render(const RenderArgs& args) {
     std::printf("scene        %s (%zu triangles)\n", scene.source.c_str(), scene.size());
     std::printf("image        %dx%d, %d AO rays per hit -> %s\n", settings.width, settings.height, settings.ao_samples, args.output.c_str());
     std::printf("accelerator  %s, %.1f bytes/triangle\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()));
+    if (const auto* bvh = std::get_if<Bvh>(accel.impl.get())) {
+      const BvhStats st = bvh->stats();
+      std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st.nodes, st.leaves,
+                  st.avg_leaf_size, st.max_leaf_size, st.max_depth, st.sah_cost);
+    }
     std::printf("scheduler    %s, %d threads\n", to_string(sched.kind).c_str(), sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads));
     std::printf("load         %10.2f ms\n", load_ms);
     std::printf("build        %10.2f ms\n", accel.build_ms);

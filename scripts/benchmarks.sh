@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Regenerates every figure behind docs/BENCHMARKS.md on this machine (about 15 minutes on 2 cores):
+# the study's table, the scheduler scaling at 1 and 2 threads, the per-task overhead, our variants
+# with Embree on all scenes, and the Google Benchmark microbenchmarks. Outputs go to docs/bench/.
+# Run from the project root with ../shared/scenes beside it, on an otherwise idle machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --preset release >/dev/null
+cmake --build --preset release
+T=build/release/tracer
+O=docs/bench
+mkdir -p "$O"
+
+{
+  echo "# Machine"
+  echo
+  echo '```'
+  lscpu | grep -E "Model name|^CPU\(s\)|Thread|MHz|L1d|L2|L3|Flags" | sed 's/Flags:.*avx512f.*/Flags: ... avx2 avx512f ... (AVX-512 capable)/'
+  free -h | head -2
+  echo "compiler: $(c++ --version | head -1)"
+  echo "embree: $(dpkg-query -W -f='${Version}' libembree-dev 2>/dev/null), tbb: $(dpkg-query -W -f='${Version}' libtbb-dev 2>/dev/null)"
+  echo "date: $(date -u +%Y-%m-%d)"
+  echo '```'
+} > "$O/machine.md"
+
+# 1. The study's table: its ten variants (ISPC waits for the SIMD kernels) plus ours and Embree.
+$T bench --scenes cornell --variants study,sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
+  --max-seconds 30 --json "$O/study.json" --markdown "$O/study.md" --plot "$O/study.svg"
+
+# 2. Schedulers at 1 and 2 threads (SAH BVH), and the per-task overhead on a near-empty scene.
+for t in 1 2; do
+  $T bench --scenes cornell,../shared/scenes/sponza/sponza.obj --variants sah,async+sah,lq+sah,atomic+sah,best \
+    --size 512x512 --ao 16 --runs 5 --best 3 --threads $t --json "$O/sched-t$t.json" --markdown "$O/sched-t$t.md"
+done
+$T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah,best --size 2048x2048 --ao 0 \
+  --runs 5 --best 3 --threads 2 --markdown "$O/overhead.md"
+
+# 3. Our best against Embree on every scene, at 1 and 2 threads.
+for t in 1 2; do
+  $T bench --scenes cornell,large --variants bvh,sah,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t \
+    --json "$O/embree-t$t.json" --markdown "$O/embree-t$t.md" --plot "$O/embree-t$t.svg"
+done
+
+# 4. Microbenchmarks: build times per split/builder, Mrays/s per ray type, bytes per triangle.
+build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console \
+  --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
+  2>/dev/null | tee "$O/microbench.txt"
+echo "figures written to $O/"
