@@ -83,6 +83,18 @@ size_t compare(const Reference& expected, const Reference& got, const std::strin
   return bad;
 }
 
+// A small render of `scene` through `accel` (one tile, so no scheduler is involved).
+template <class A>
+Image8 render_small(const A& accel, const Scene& scene, int size) {
+  RenderSettings s;
+  s.width = s.height = size;
+  const CameraSpec cam{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
+  Framebuffer fb(size, size);
+  RenderContext ctx{&scene, Camera(cam, size, size), s, &fb};
+  render_tile(accel, ctx, Tile{0, 0, size, size});
+  return tonemap(fb, s.exposure);
+}
+
 std::vector<BvhBuildOptions> all_builds() {
   std::vector<BvhBuildOptions> v;
   for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
@@ -139,17 +151,8 @@ TEST(BvhAgreement, RenderedImagesMatchBruteForce) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
   for (const char* name : {"Original", "Sphere", "Water"}) {
     const Scene scene = load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
-    RenderSettings s;
-    s.width = s.height = 40;
-    const CameraSpec cam{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
-    const auto image = [&](const auto& accel) {
-      Framebuffer fb(s.width, s.height);
-      RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-      render_tile(accel, ctx, Tile{0, 0, s.width, s.height});
-      return tonemap(fb, s.exposure).rgb;
-    };
-    const auto reference = image(BruteForce(scene));
-    for (const BvhBuildOptions& o : all_builds()) EXPECT_EQ(image(Bvh(scene, o)), reference) << name << " " << describe(o);
+    const auto reference = render_small(BruteForce(scene), scene, 40).rgb;
+    for (const BvhBuildOptions& o : all_builds()) EXPECT_EQ(render_small(Bvh(scene, o), scene, 40).rgb, reference) << name << " " << describe(o);
   }
 }
 
@@ -259,17 +262,8 @@ TEST(BvhAgreement, EmbreeAgreesOnCornellScenes) {
     }
     EXPECT_LE(differ, ours.hits.size() / 10000 + 1) << "of " << ours.hits.size();
     // And the rendered images match (same rays, same shading): PSNR >= 40 dB.
-    RenderSettings s;
-    s.width = s.height = 64;
-    const CameraSpec cam{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
-    const auto image = [&](const auto& accel) {
-      Framebuffer fb(s.width, s.height);
-      RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-      render_tile(accel, ctx, Tile{0, 0, s.width, s.height});
-      return tonemap(fb, s.exposure);
-    };
-    const Image8 a = image(Bvh(scene, BvhBuildOptions{}));
-    const Image8 b = embree.visit([&](const auto& acc) { return image(acc); });
+    const Image8 a = render_small(Bvh(scene, BvhBuildOptions{}), scene, 64);
+    const Image8 b = embree.visit([&](const auto& acc) { return render_small(acc, scene, 64); });
     // Embree's triangle test is not watertight: a camera ray exactly on a shared edge can slip
     // through (a black pixel) where ours hits. Allow that on at most 1% of pixels, nothing more.
     size_t differing = 0;

@@ -22,15 +22,7 @@ class BruteForce {
     const RayShear shear(ray);
     hit = Hit{};
     hit.t = ray.tfar;
-    for (size_t i = 0; i < tris_.size(); ++i) {
-      TriangleHit th;
-      if (intersect_triangle(shear, tris_[i], ray.tnear, hit.t, th) && closer(th.t, ids_[i], hit)) {
-        hit.t = th.t;
-        hit.u = th.u;
-        hit.v = th.v;
-        hit.tri = ids_[i];
-      }
-    }
+    intersect_range(shear, tris_.data(), ids_.data(), 0, static_cast<uint32_t>(tris_.size()), ray.tnear, hit);
     if (!hit.valid()) return false;
     hit.geomID = scene_->tri_geom[hit.tri];
     hit.primID = scene_->tri_prim[hit.tri];

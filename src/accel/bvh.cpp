@@ -20,15 +20,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
   for (;;) {
     const BvhNode& node = nodes_[current];
     if (node.leaf()) {
-      for (uint32_t i = node.index, end = node.index + node.count; i < end; ++i) {
-        TriangleHit th;
-        if (intersect_triangle(shear, tris_[i], ray.tnear, hit.t, th) && closer(th.t, ids_[i], hit)) {
-          hit.t = th.t;
-          hit.u = th.u;
-          hit.v = th.v;
-          hit.tri = ids_[i];
-        }
-      }
+      intersect_range(shear, tris_.data(), ids_.data(), node.index, node.index + node.count, ray.tnear, hit);
     } else {
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];

@@ -37,11 +37,40 @@ struct BuildNode {
   uint32_t begin = 0, end = 0;
   uint32_t left = kNone;  // children at left and left+1, or kNone for a leaf
   uint32_t depth = 0;
+  Aabb cbox;                  // bounds of the centroids
+  bool bounds_known = false;  // box and cbox already computed by the parent's partition pass
 };
 
 // A triangle's box padded to four lanes for the binning loop.
 struct alignas(32) Box4 {
   float lo[4], hi[4];
+};
+
+// Box and centroid bounds accumulated four lanes at a time (vectorised min/max).
+struct Bounds4 {
+  float lo[4], hi[4], clo[4], chi[4];
+  Bounds4() {
+    for (int k = 0; k < 4; ++k) { lo[k] = clo[k] = kInfinity; hi[k] = chi[k] = -kInfinity; }
+  }
+  void add(const Box4& box) {
+    for (int k = 0; k < 4; ++k) {
+      const float c = (box.lo[k] + box.hi[k]) * 0.5f;  // = Aabb::center(), the binning centroid
+      lo[k] = box.lo[k] < lo[k] ? box.lo[k] : lo[k];
+      hi[k] = box.hi[k] > hi[k] ? box.hi[k] : hi[k];
+      clo[k] = c < clo[k] ? c : clo[k];
+      chi[k] = c > chi[k] ? c : chi[k];
+    }
+  }
+  void join(const Bounds4& o) {
+    for (int k = 0; k < 4; ++k) {
+      lo[k] = o.lo[k] < lo[k] ? o.lo[k] : lo[k];
+      hi[k] = o.hi[k] > hi[k] ? o.hi[k] : hi[k];
+      clo[k] = o.clo[k] < clo[k] ? o.clo[k] : clo[k];
+      chi[k] = o.chi[k] > chi[k] ? o.chi[k] : chi[k];
+    }
+  }
+  Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+  Aabb centroids() const { return Aabb{{clo[0], clo[1], clo[2]}, {chi[0], chi[1], chi[2]}}; }
 };
 
 struct Bounds2 {
@@ -238,26 +267,19 @@ class BvhBuilder {
   bool split(uint32_t id, bool parallel) {
     BuildNode& node = nodes_[id];
     const uint32_t begin = node.begin, end = node.end, count = end - begin;
-    const Bounds2 bounds = reduce_range(begin, end, parallel, Bounds2{}, [&](uint32_t b, uint32_t e, Bounds2 acc) {
-      // Four-lane accumulators (vectorised min/max); centroid = (lo + hi) / 2 lane-wise.
-      float lo[4], hi[4], clo[4], chi[4];
-      for (int k = 0; k < 4; ++k) { lo[k] = clo[k] = kInfinity; hi[k] = chi[k] = -kInfinity; }
-      for (uint32_t i = b; i < e; ++i) {
-        const Box4& box = box4_[prims_[i]];
-        for (int k = 0; k < 4; ++k) {
-          const float c = (box.lo[k] + box.hi[k]) * 0.5f;
-          lo[k] = box.lo[k] < lo[k] ? box.lo[k] : lo[k];
-          hi[k] = box.hi[k] > hi[k] ? box.hi[k] : hi[k];
-          clo[k] = c < clo[k] ? c : clo[k];
-          chi[k] = c > chi[k] ? c : chi[k];
-        }
-      }
-      acc.box.extend(Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
-      acc.centroids.extend(Aabb{{clo[0], clo[1], clo[2]}, {chi[0], chi[1], chi[2]}});
-      return acc;
-    });
-    node.box = bounds.box;
+    if (!node.bounds_known) {
+      const Bounds4 b = reduce_range(begin, end, parallel, Bounds4{}, [&](uint32_t from, uint32_t to, Bounds4 acc) {
+        for (uint32_t i = from; i < to; ++i) acc.add(box4_[prims_[i]]);
+        return acc;
+      });
+      node.box = b.box();
+      node.cbox = b.centroids();
+      node.bounds_known = true;
+    }
+    const Bounds2 bounds{node.box, node.cbox};
     uint32_t mid;
+    Bounds4 child_bounds[2];
+    bool children_known = false;
     if (options_.split == BvhSplit::Median) {
       if (count <= 2) return false;  // the study's leaves of one or two triangles
       mid = median_split(begin, end, static_cast<int>(node.depth % 3));
@@ -277,15 +299,26 @@ class BvhBuilder {
           const float leaf_cost = options_.intersection_cost * float(count);
           if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
           const Binner binner(bounds.centroids, sah.bins);
-          mid = partition(begin, end, parallel, [&](uint32_t prim) {
+          Bounds4 lb, rb;
+          mid = partition(begin, end, begin + sah.left_count, parallel, lb, rb, [&](uint32_t prim) {
             return binner(centroids_[prim][sah.axis], sah.axis) < sah.split_bin;
           });
+          child_bounds[0] = lb;
+          child_bounds[1] = rb;
+          children_known = true;
         }
       }
     }
     const uint32_t left = node_count_.fetch_add(2, std::memory_order_relaxed);
     nodes_[left] = BuildNode{{}, begin, mid, kNone, node.depth + 1};
     nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
+    if (children_known) {
+      for (int c = 0; c < 2; ++c) {
+        nodes_[left + c].box = child_bounds[c].box();
+        nodes_[left + c].cbox = child_bounds[c].centroids();
+        nodes_[left + c].bounds_known = true;
+      }
+    }
     node.left = left;
     return true;
   }
@@ -300,7 +333,7 @@ class BvhBuilder {
     return mid;
   }
 
-  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; int bins = 0; };
+  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; int bins = 0; uint32_t left_count = 0; };
 
   // Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
   // initialised, which matters because most nodes are small.
@@ -395,7 +428,7 @@ class BvhBuilder {
         if (acc.count == 0) continue;
         const float cost = options_.traversal_cost +
                            options_.intersection_cost * (acc.box().half_area() * float(acc.count) + right_cost[s]) * inv_area;
-        if (cost < best.cost) best = {a, s, cost};
+        if (cost < best.cost) best = {a, s, cost, nb, acc.count};
       }
     }
     if (!(best.cost < kInfinity)) best.axis = -1;
@@ -403,18 +436,23 @@ class BvhBuilder {
     return best;
   }
 
-  // Stable partition of prims_[begin, end) by `pred`; returns the first index of the false part.
-  // The parallel path computes the same permutation as the sequential one.
+  // Stable partition of prims_[begin, end) by `pred`, whose true count the binning already gave
+  // (`mid` = begin + that count), gathering each side's box and centroid bounds on the way so
+  // the children need no bounds pass of their own. The parallel path computes the same
+  // permutation and bounds as the sequential one.
   template <class Pred>
-  uint32_t partition(uint32_t begin, uint32_t end, bool parallel, const Pred& pred) {
+  uint32_t partition(uint32_t begin, uint32_t end, uint32_t mid, bool parallel, Bounds4& lb, Bounds4& rb, const Pred& pred) {
     if (!parallel) {
-      uint32_t out = begin;
+      uint32_t l = begin, r = mid;
       for (uint32_t i = begin; i < end; ++i) {
-        if (pred(prims_[i])) scratch_[out++] = prims_[i];
-      }
-      const uint32_t mid = out;
-      for (uint32_t i = begin; i < end; ++i) {
-        if (!pred(prims_[i])) scratch_[out++] = prims_[i];
+        const uint32_t p = prims_[i];
+        if (pred(p)) {
+          scratch_[l++] = p;
+          lb.add(box4_[p]);
+        } else {
+          scratch_[r++] = p;
+          rb.add(box4_[p]);
+        }
       }
       std::copy(scratch_.begin() + begin, scratch_.begin() + end, prims_.begin() + begin);
       return mid;
@@ -430,18 +468,28 @@ class BvhBuilder {
     });
     publish();
     for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
-    const uint32_t mid = begin + left_counts[blocks];
+    std::vector<Bounds4> block_l(blocks), block_r(blocks);
     tbb::parallel_for(0u, blocks, [&](uint32_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       uint32_t l = begin + left_counts[k];
       uint32_t r = mid + (b - begin) - left_counts[k];  // rights before this block
       for (uint32_t i = b; i < e; ++i) {
-        if (pred(prims_[i])) scratch_[l++] = prims_[i];
-        else scratch_[r++] = prims_[i];
+        const uint32_t p = prims_[i];
+        if (pred(p)) {
+          scratch_[l++] = p;
+          block_l[k].add(box4_[p]);
+        } else {
+          scratch_[r++] = p;
+          block_r[k].add(box4_[p]);
+        }
       }
       publish();
     });
     publish();
+    for (uint32_t k = 0; k < blocks; ++k) {
+      lb.join(block_l[k]);
+      rb.join(block_r[k]);
+    }
     tbb::parallel_for(tbb::blocked_range<uint32_t>(begin, end, kPartitionBlock), [&](const tbb::blocked_range<uint32_t>& r) {
       std::copy(scratch_.begin() + r.begin(), scratch_.begin() + r.end(), prims_.begin() + r.begin());
       publish();

@@ -68,4 +68,19 @@ inline bool closer(float t, uint32_t tri, const Hit& best) {
   return t < best.t || (t == best.t && tri < best.tri);
 }
 
+// Closest hit among tris[begin, end) whose scene indices are ids[...]: updates `hit` (t, u, v,
+// tri) where a triangle is closer. The leaf loop of every scalar accelerator.
+inline void intersect_range(const RayShear& shear, const Triangle* tris, const uint32_t* ids, uint32_t begin, uint32_t end,
+                            float tnear, Hit& hit) {
+  for (uint32_t i = begin; i < end; ++i) {
+    TriangleHit th;
+    if (intersect_triangle(shear, tris[i], tnear, hit.t, th) && closer(th.t, ids[i], hit)) {
+      hit.t = th.t;
+      hit.u = th.u;
+      hit.v = th.v;
+      hit.tri = ids[i];
+    }
+  }
+}
+
 }  // namespace tracer

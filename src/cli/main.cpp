@@ -35,6 +35,9 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 int cmd_render(const RenderArgs& args) {
+  // Installed first, so a Ctrl-C during loading or the build is not lost: the render then stops
+  // at its first tile.
+  install_sigint_handler();
   validate(args);
   image_format_for(args.output, "-o");
   check_writable(args.output);
@@ -52,7 +55,6 @@ int cmd_render(const RenderArgs& args) {
   RenderContext ctx{&scene, Camera(camera, settings.width, settings.height), settings, &fb};
   RenderControl control;
   control.cancel = &g_interrupted;
-  install_sigint_handler();
   const auto t_render = std::chrono::steady_clock::now();
   bool finished;
   {
