@@ -8,6 +8,7 @@ namespace tracer {
 
 static_assert(RayAccelerator<BruteForce>);
 static_assert(RayAccelerator<Bvh>);
+static_assert(RayAccelerator<WideBvh>);
 
 bool embree_available() {
 #ifdef TRACER_HAVE_EMBREE
@@ -32,6 +33,10 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
     case AccelKind::Bvh:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);
       acc.name = options.bvh.split == BvhSplit::Sah ? "bvh-sah" : "bvh-median";
+      break;
+    case AccelKind::Bvh8:
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, options.bvh);
+      acc.name = "bvh8-" + WideBvh::simd_target();
       break;
     case AccelKind::Embree:
 #ifdef TRACER_HAVE_EMBREE

@@ -11,6 +11,7 @@
 
 #include "accel/brute_force.hpp"
 #include "accel/bvh.hpp"
+#include "accel/wide_bvh.hpp"
 #ifdef TRACER_HAVE_EMBREE
 #include "accel/embree_accel.hpp"
 #endif
@@ -23,14 +24,14 @@ concept RayAccelerator = requires(const A& a, const Ray& r, Hit& h) {
   { a.occluded(r) } -> std::same_as<bool>;
 };
 
-enum class AccelKind { Brute, Bvh, Embree };
+enum class AccelKind { Brute, Bvh, Bvh8, Embree };
 
 struct AccelOptions {
   AccelKind kind = AccelKind::Bvh;
   BvhBuildOptions bvh;
 };
 
-using AccelVariant = std::variant<BruteForce, Bvh
+using AccelVariant = std::variant<BruteForce, Bvh, WideBvh
 #ifdef TRACER_HAVE_EMBREE
                                   , EmbreeAccel
 #endif

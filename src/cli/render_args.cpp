@@ -29,11 +29,12 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--ambient", a.ambient, "ambient light strength")->capture_default_str();
   app.add_option("--exposure", a.exposure, "tone-mapping exposure")->capture_default_str();
   app.add_option("--seed", a.seed, "seed of the AO sample pattern")->capture_default_str();
-  app.add_option("--accel", a.accel, "accelerator: brute, bvh, embree")->capture_default_str();
+  app.add_option("--accel", a.accel, "accelerator: brute, bvh, bvh8 (8-wide SIMD), embree")->capture_default_str();
   app.add_option("--bvh-split", a.split, "BVH split: sah or median (the study's)")->capture_default_str();
   app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
   app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
   app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
+  app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
@@ -72,6 +73,9 @@ void validate(const RenderArgs& a) {
   for (const auto& l : a.scene.lights) parse_vec3("--light", l);
   accel_options_for(a);
   parse_sched(a.sched);
+  if (!WideBvh::force_simd_target(lower(a.simd_target))) {
+    throw UsageError("--simd-target: unknown target '" + a.simd_target + "' (auto, avx512, avx2, sse4)");
+  }
 }
 
 Scene load_scene(const SceneArgs& a) {
@@ -120,8 +124,9 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   const std::string accel = lower(a.accel);
   if (accel == "brute") o.kind = AccelKind::Brute;
   else if (accel == "bvh") o.kind = AccelKind::Bvh;
+  else if (accel == "bvh8") o.kind = AccelKind::Bvh8;
   else if (accel == "embree") o.kind = AccelKind::Embree;
-  else throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, embree)");
+  else throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, bvh8, embree)");
   const std::string split = lower(a.split);
   if (split == "sah") o.bvh.split = BvhSplit::Sah;
   else if (split == "median") o.bvh.split = BvhSplit::Median;

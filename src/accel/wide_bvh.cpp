@@ -1,0 +1,299 @@
+// WideBvh: collapse from the binary tree (once), and the traversal kernels, compiled once per
+// SIMD target by Highway's foreach_target (this file includes itself for each target).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/wide_bvh.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "accel/wide_bvh.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Per-ray constants of the slab test: the same arithmetic as the scalar RayBoxTest, so a child
+// is kept exactly when the binary tree would keep it (NaN from 0*inf never culls).
+struct WideRay {
+  float ox, oy, oz, ix, iy, iz;
+  bool nx, ny, nz;
+  explicit WideRay(const Ray& r) : ox(r.org.x), oy(r.org.y), oz(r.org.z) {
+    ix = 1.0f / r.dir.x;
+    iy = 1.0f / r.dir.y;
+    iz = 1.0f / r.dir.z;
+    nx = std::signbit(ix);
+    ny = std::signbit(iy);
+    nz = std::signbit(iz);
+  }
+};
+
+// Tests all children of `n`; writes their entry distances to t_out and returns one bit per child hit.
+HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar, float* HWY_RESTRICT t_out) {
+  constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+  const hn::CappedTag<float, kWideWidth> d;
+  const size_t lanes = hn::Lanes(d);
+  const float* near_x = r.nx ? n.hi_x : n.lo_x;
+  const float* far_x = r.nx ? n.lo_x : n.hi_x;
+  const float* near_y = r.ny ? n.hi_y : n.lo_y;
+  const float* far_y = r.ny ? n.lo_y : n.hi_y;
+  const float* near_z = r.nz ? n.hi_z : n.lo_z;
+  const float* far_z = r.nz ? n.lo_z : n.hi_z;
+  const auto ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
+  const auto ix = hn::Set(d, r.ix), iy = hn::Set(d, r.iy), iz = hn::Set(d, r.iz);
+  const auto guard = hn::Set(d, kGuard);
+  const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar * RayBoxTest::kTieGuard);
+  uint32_t bits = 0;
+  for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
+    auto t0 = vnear, t1 = vfar;
+    const auto a = hn::Mul(hn::Sub(hn::Load(d, near_x + i), ox), ix);
+    const auto b = hn::Mul(hn::Sub(hn::Load(d, near_y + i), oy), iy);
+    const auto c = hn::Mul(hn::Sub(hn::Load(d, near_z + i), oz), iz);
+    t0 = hn::IfThenElse(a > t0, a, t0);  // NaN compares false: no cull
+    t0 = hn::IfThenElse(b > t0, b, t0);
+    t0 = hn::IfThenElse(c > t0, c, t0);
+    const auto e = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_x + i), ox), ix), guard);
+    const auto f = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_y + i), oy), iy), guard);
+    const auto g = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_z + i), oz), iz), guard);
+    t1 = hn::IfThenElse(e < t1, e, t1);
+    t1 = hn::IfThenElse(f < t1, f, t1);
+    t1 = hn::IfThenElse(g < t1, g, t1);
+    hn::Store(t0, d, t_out + i);
+    uint8_t mask_bits[8] = {0};
+    hn::StoreMaskBits(d, t0 <= t1, mask_bits);
+    bits |= uint32_t(mask_bits[0]) << i;
+  }
+  return bits;
+}
+
+struct StackEntry {
+  uint32_t child, count;
+  float t;
+};
+
+// Sorts the hit children by entry distance and pushes them farthest first, so the nearest is
+// popped next. At most eight entries: insertion sort.
+HWY_INLINE void PushSorted(const WideNode& n, uint32_t bits, const float* t, StackEntry* stack, int& sp) {
+  StackEntry hits[kWideWidth];
+  int k = 0;
+  while (bits) {
+    const int i = __builtin_ctz(bits);
+    bits &= bits - 1;
+    StackEntry e{n.child[i], n.count[i], t[i]};
+    int j = k++;
+    while (j > 0 && hits[j - 1].t < e.t) {  // descending: farthest first
+      hits[j] = hits[j - 1];
+      --j;
+    }
+    hits[j] = e;
+  }
+  for (int i = 0; i < k; ++i) stack[sp++] = hits[i];
+}
+
+bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
+  hit = Hit{};
+  hit.t = ray.tfar;
+  const auto& nodes = bvh.nodes();
+  if (nodes.empty()) return false;
+  const WideRay wr(ray);
+  const RayShear shear(ray);
+  const Triangle* tris = bvh.triangles().data();
+  const uint32_t* ids = bvh.triangle_ids().data();
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  stack[sp++] = {0, 0, ray.tnear};
+  HWY_ALIGN float t[kWideWidth];
+  while (sp > 0) {
+    const StackEntry e = stack[--sp];
+    if (!(e.t <= hit.t * RayBoxTest::kTieGuard)) continue;
+    if (e.count > 0) {
+      intersect_range(shear, tris, ids, e.child, e.child + e.count, ray.tnear, hit);
+      continue;
+    }
+    const WideNode& n = nodes[e.child];
+    const uint32_t bits = TestChildren(n, wr, ray.tnear, hit.t, t);
+    PushSorted(n, bits, t, stack, sp);
+  }
+  if (!hit.valid()) return false;
+  hit.geomID = bvh.scene().tri_geom[hit.tri];
+  hit.primID = bvh.scene().tri_prim[hit.tri];
+  return true;
+}
+
+bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
+  const auto& nodes = bvh.nodes();
+  if (nodes.empty()) return false;
+  const WideRay wr(ray);
+  const RayShear shear(ray);
+  const Triangle* tris = bvh.triangles().data();
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  stack[sp++] = {0, 0, ray.tnear};
+  HWY_ALIGN float t[kWideWidth];
+  while (sp > 0) {
+    const StackEntry e = stack[--sp];
+    if (e.count > 0) {
+      TriangleHit th;
+      for (uint32_t i = e.child; i < e.child + e.count; ++i) {
+        if (intersect_triangle(shear, tris[i], ray.tnear, ray.tfar, th)) return true;
+      }
+      continue;
+    }
+    const WideNode& n = nodes[e.child];
+    PushSorted(n, TestChildren(n, wr, ray.tnear, ray.tfar, t), t, stack, sp);
+  }
+  return false;
+}
+
+int64_t CurrentTarget() { return HWY_TARGET; }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer {
+
+HWY_EXPORT(IntersectWide);
+HWY_EXPORT(OccludedWide);
+HWY_EXPORT(CurrentTarget);
+
+// One table-indexed call per ray (Highway's dynamic dispatch), never per node: the kernels above
+// inline the whole traversal.
+bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectWide)(*this, ray, hit); }
+bool WideBvh::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedWide)(*this, ray); }
+
+std::string WideBvh::simd_target() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CurrentTarget)()); }
+
+bool WideBvh::force_simd_target(const std::string& name) {
+  if (name == "auto" || name == "avx512") {
+    hwy::DisableTargets(0);
+  } else if (name == "avx2") {
+    hwy::DisableTargets(HWY_AVX3 | HWY_AVX3_DL);
+  } else if (name == "sse4") {
+    hwy::DisableTargets(HWY_AVX2 | HWY_AVX3 | HWY_AVX3_DL);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// Collapses the binary subtree under `root` into wide nodes, appending to `out`; returns the
+// index of the wide node made for `root`.
+class Collapser {
+ public:
+  Collapser(const Bvh& bin, std::vector<WideNode>& out) : bin_(bin), out_(out) {}
+
+  uint32_t collapse(uint32_t root) {
+    // Open the largest inner node until eight children (or only leaves) remain: keeps the
+    // children's total surface area, and so the expected cost, as low as greedy can.
+    std::vector<uint32_t> kids{root};
+    if (!bin_.nodes()[root].leaf()) kids = {bin_.nodes()[root].index, bin_.nodes()[root].index + 1};
+    while (kids.size() < size_t(kWideWidth)) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (size_t i = 0; i < kids.size(); ++i) {
+        const BvhNode& n = bin_.nodes()[kids[i]];
+        const float area = Aabb{n.lo, n.hi}.half_area();
+        if (!n.leaf() && area > best_area) {
+          best = int(i);
+          best_area = area;
+        }
+      }
+      if (best < 0) break;
+      const BvhNode& n = bin_.nodes()[kids[size_t(best)]];
+      kids[size_t(best)] = n.index;
+      kids.insert(kids.begin() + best + 1, n.index + 1);
+    }
+    const auto self = static_cast<uint32_t>(out_.size());
+    out_.emplace_back();
+    {
+      WideNode& w = out_[self];
+      for (int i = 0; i < kWideWidth; ++i) {
+        w.lo_x[i] = w.lo_y[i] = w.lo_z[i] = kInfinity;
+        w.hi_x[i] = w.hi_y[i] = w.hi_z[i] = -kInfinity;
+        w.child[i] = 0;
+        w.count[i] = 0;
+      }
+    }
+    for (size_t i = 0; i < kids.size(); ++i) {
+      const BvhNode& n = bin_.nodes()[kids[i]];
+      uint32_t child = n.index, count = n.count;
+      if (!n.leaf()) child = collapse(kids[i]);  // may reallocate out_: index, not reference
+      WideNode& w = out_[self];
+      w.lo_x[i] = n.lo.x;
+      w.lo_y[i] = n.lo.y;
+      w.lo_z[i] = n.lo.z;
+      w.hi_x[i] = n.hi.x;
+      w.hi_y[i] = n.hi.y;
+      w.hi_z[i] = n.hi.z;
+      w.child[i] = child;
+      w.count[i] = count;
+    }
+    return self;
+  }
+
+ private:
+  const Bvh& bin_;
+  std::vector<WideNode>& out_;
+};
+
+}  // namespace
+
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene) {
+  const Bvh binary(scene, options);
+  tris_ = binary.triangles();
+  ids_ = binary.triangle_ids();
+  if (binary.nodes().empty()) return;
+  nodes_.reserve(binary.nodes().size() / 4 + 1);
+  Collapser(binary, nodes_).collapse(0);
+  empty_root_ = false;
+}
+
+std::string WideBvh::validate() const {
+  if (nodes_.empty()) return tris_.empty() ? "" : "triangles but no nodes";
+  std::vector<uint32_t> seen(scene_->size(), 0);
+  std::vector<uint32_t> visits(nodes_.size(), 0);
+  std::vector<uint32_t> stack{0};
+  // Every triangle below a child must lie in that child's box; check leaf by leaf.
+  struct Pending { uint32_t node; Aabb box; };
+  std::vector<Pending> work{{0, Aabb{{-kInfinity, -kInfinity, -kInfinity}, {kInfinity, kInfinity, kInfinity}}}};
+  while (!work.empty()) {
+    const Pending p = work.back();
+    work.pop_back();
+    if (p.node >= nodes_.size()) return "node index out of range";
+    if (++visits[p.node] > 1) return "node " + std::to_string(p.node) + " reached twice";
+    const WideNode& n = nodes_[p.node];
+    for (int i = 0; i < kWideWidth; ++i) {
+      const Aabb box{{n.lo_x[i], n.lo_y[i], n.lo_z[i]}, {n.hi_x[i], n.hi_y[i], n.hi_z[i]}};
+      if (box.empty()) {
+        if (n.count[i] != 0 || n.child[i] != 0) return "empty slot with contents";
+        continue;
+      }
+      if (!p.box.contains(box)) return "child box outside its parent's box";
+      if (n.count[i] > 0) {
+        if (size_t(n.child[i]) + n.count[i] > tris_.size()) return "leaf range out of bounds";
+        for (uint32_t k = n.child[i]; k < n.child[i] + n.count[i]; ++k) {
+          if (!box.contains(tris_[k].bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
+          ++seen[ids_[k]];
+        }
+      } else {
+        work.push_back({n.child[i], box});
+      }
+    }
+  }
+  for (size_t i = 0; i < seen.size(); ++i) {
+    const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
+    if (seen[i] != expected) return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
+  }
+  for (size_t i = 0; i < visits.size(); ++i) {
+    if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
+  }
+  return "";
+}
+
+}  // namespace tracer
+#endif  // HWY_ONCE

@@ -1,0 +1,60 @@
+// 8-wide BVH collapsed from the binary SAH tree: each node holds its children's boxes as SoA
+// arrays so one SIMD pass tests a ray against all eight, and children are visited nearest first.
+// The box kernel is compiled for SSE4, AVX2 and AVX-512 with Google Highway and chosen at run
+// time for the CPU it runs on; leaves use the same watertight triangle test as everything else,
+// so hits are identical to the binary BVH's and brute force's.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "accel/bvh.hpp"
+
+namespace tracer {
+
+inline constexpr int kWideWidth = 8;
+
+struct alignas(64) WideNode {
+  // Children's boxes, one lane per child; an empty slot has lo = +inf, hi = -inf and never hits.
+  float lo_x[kWideWidth], lo_y[kWideWidth], lo_z[kWideWidth];
+  float hi_x[kWideWidth], hi_y[kWideWidth], hi_z[kWideWidth];
+  uint32_t child[kWideWidth];  // inner child: node index; leaf child: first triangle
+  uint32_t count[kWideWidth];  // 0: inner child; > 0: leaf of `count` triangles
+};
+static_assert(sizeof(WideNode) == 256);
+
+class WideBvh {
+ public:
+  // Builds the binary SAH tree with `options`, then collapses it.
+  WideBvh(const Scene& scene, const BvhBuildOptions& options);
+
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+
+  const std::vector<WideNode>& nodes() const { return nodes_; }
+  const std::vector<Triangle>& triangles() const { return tris_; }
+  const std::vector<uint32_t>& triangle_ids() const { return ids_; }
+  size_t memory_bytes() const {
+    return nodes_.size() * sizeof(WideNode) + tris_.size() * sizeof(Triangle) + ids_.size() * sizeof(uint32_t);
+  }
+  // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf.
+  std::string validate() const;
+  const Scene& scene() const { return *scene_; }
+
+  // The SIMD target the kernels run on (e.g. "AVX3", "AVX2", "SSE4").
+  static std::string simd_target();
+  // Restricts the kernels to targets no wider than `name` ("sse4", "avx2", "avx512"); for
+  // testing every target and for `--simd-target`. Returns false for an unknown name.
+  static bool force_simd_target(const std::string& name);
+
+ private:
+  friend struct WideBvhAccess;
+  const Scene* scene_;
+  std::vector<WideNode> nodes_;
+  std::vector<Triangle> tris_;
+  std::vector<uint32_t> ids_;
+  bool empty_root_ = true;
+};
+
+}  // namespace tracer
