@@ -24,20 +24,20 @@ mkdir -p "$O"
 } > "$O/machine.md"
 
 # 1. The study's table: its ten variants (ISPC waits for the SIMD kernels) plus ours and Embree.
-$T bench --scenes cornell --variants study,sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
+$T bench --scenes cornell --variants study,sah,tbb+sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
   --max-seconds 30 --json "$O/study.json" --markdown "$O/study.md" --plot "$O/study.svg"
 
 # 2. Schedulers at 1 and 2 threads (SAH BVH), and the per-task overhead on a near-empty scene.
 for t in 1 2; do
-  $T bench --scenes cornell,../shared/scenes/sponza/sponza.obj --variants sah,async+sah,lq+sah,atomic+sah,best \
+  $T bench --scenes cornell,../shared/scenes/sponza/sponza.obj --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah \
     --size 512x512 --ao 16 --runs 5 --best 3 --threads $t --json "$O/sched-t$t.json" --markdown "$O/sched-t$t.md"
 done
-$T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah,best --size 2048x2048 --ao 0 \
+$T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah --size 2048x2048 --ao 0 \
   --runs 5 --best 3 --threads 2 --markdown "$O/overhead.md"
 
 # 3. Our best against Embree on every scene, at 1 and 2 threads.
 for t in 1 2; do
-  $T bench --scenes cornell,large --variants bvh,sah,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t \
+  $T bench --scenes cornell,large --variants bvh,sah,tbb+sah,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t \
     --json "$O/embree-t$t.json" --markdown "$O/embree-t$t.md" --plot "$O/embree-t$t.svg"
 done
 

@@ -6,6 +6,8 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "accel/wide_bvh.hpp"
 
@@ -67,6 +69,66 @@ HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnea
   return bits;
 }
 
+// One ray against the triangles of `pack`, lane-parallel: the watertight test of
+// triangle_test.hpp with the same operations in the same order, so each lane's t, u, v equal
+// the scalar test's bit for bit. Lanes whose edge function is exactly zero are redone by the
+// scalar test (which decides them in double), as are none in the common case.
+// Returns the mask of lanes hit within [tnear, tfar]; their t, u, v go to the arrays.
+HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, const Triangle* tris, float tnear, float tfar,
+                                  float* HWY_RESTRICT t_out, float* HWY_RESTRICT u_out, float* HWY_RESTRICT v_out) {
+  const hn::CappedTag<float, kWideWidth> d;
+  const size_t lanes = hn::Lanes(d);
+  const float org[3] = {s.org.x, s.org.y, s.org.z};
+  const auto okx = hn::Set(d, org[s.kx]), oky = hn::Set(d, org[s.ky]), okz = hn::Set(d, org[s.kz]);
+  const auto sx = hn::Set(d, s.sx), sy = hn::Set(d, s.sy), sz = hn::Set(d, s.sz);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
+  const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar);
+  uint32_t bits = 0;
+  for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
+    const auto ax_ = hn::Sub(hn::Load(d, p.v[0][s.kx] + i), okx), ay_ = hn::Sub(hn::Load(d, p.v[0][s.ky] + i), oky),
+               az_ = hn::Sub(hn::Load(d, p.v[0][s.kz] + i), okz);
+    const auto bx_ = hn::Sub(hn::Load(d, p.v[1][s.kx] + i), okx), by_ = hn::Sub(hn::Load(d, p.v[1][s.ky] + i), oky),
+               bz_ = hn::Sub(hn::Load(d, p.v[1][s.kz] + i), okz);
+    const auto cx_ = hn::Sub(hn::Load(d, p.v[2][s.kx] + i), okx), cy_ = hn::Sub(hn::Load(d, p.v[2][s.ky] + i), oky),
+               cz_ = hn::Sub(hn::Load(d, p.v[2][s.kz] + i), okz);
+    const auto ax = hn::Sub(ax_, hn::Mul(sx, az_)), ay = hn::Sub(ay_, hn::Mul(sy, az_));
+    const auto bx = hn::Sub(bx_, hn::Mul(sx, bz_)), by = hn::Sub(by_, hn::Mul(sy, bz_));
+    const auto cx = hn::Sub(cx_, hn::Mul(sx, cz_)), cy = hn::Sub(cy_, hn::Mul(sy, cz_));
+    const auto u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+    const auto v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+    const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    const auto neg = hn::Or(hn::Or(u < zero, v < zero), w < zero);
+    const auto pos = hn::Or(hn::Or(u > zero, v > zero), w > zero);
+    const auto det = hn::Add(hn::Add(u, v), w);
+    const auto rcp = hn::Div(one, det);
+    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))), rcp);
+    auto hit = hn::AndNot(hn::And(neg, pos), det != zero);
+    hit = hn::And(hit, hn::And(hn::And(t >= vnear, t <= vfar), t < inf));
+    hn::Store(t, d, t_out + i);
+    hn::Store(hn::Mul(v, rcp), d, u_out + i);
+    hn::Store(hn::Mul(w, rcp), d, v_out + i);
+    uint8_t hit_bits[8] = {0}, edge_bits[8] = {0};
+    hn::StoreMaskBits(d, hit, hit_bits);
+    hn::StoreMaskBits(d, hn::Or(hn::Or(u == zero, v == zero), w == zero), edge_bits);
+    uint32_t h = hit_bits[0], edge = edge_bits[0];
+    while (edge) {  // exactly on an edge in float: let the scalar test decide in double
+      const int k = __builtin_ctz(edge);
+      edge &= edge - 1;
+      const uint32_t slot = p.slot[i + size_t(k)];
+      TriangleHit th;
+      h &= ~(1u << k);
+      if (slot != 0xffffffffu && intersect_triangle(s, tris[slot], tnear, tfar, th)) {
+        h |= 1u << k;
+        t_out[i + size_t(k)] = th.t;
+        u_out[i + size_t(k)] = th.u;
+        v_out[i + size_t(k)] = th.v;
+      }
+    }
+    bits |= h << i;
+  }
+  return bits;
+}
+
 struct StackEntry {
   uint32_t child, count;
   float t;
@@ -108,7 +170,18 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
     const StackEntry e = stack[--sp];
     if (!(e.t <= hit.t * RayBoxTest::kTieGuard)) continue;
     if (e.count > 0) {
-      intersect_range(shear, tris, ids, e.child, e.child + e.count, ray.tnear, hit);
+      const TrianglePack& p = bvh.packs()[e.child];
+      HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+      for (uint32_t bits = IntersectPack(p, shear, tris, ray.tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        const uint32_t id = ids[p.slot[k]];
+        if (closer(tt[k], id, hit)) {
+          hit.t = tt[k];
+          hit.u = uu[k];
+          hit.v = vv[k];
+          hit.tri = id;
+        }
+      }
       continue;
     }
     const WideNode& n = nodes[e.child];
@@ -134,10 +207,8 @@ bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
   while (sp > 0) {
     const StackEntry e = stack[--sp];
     if (e.count > 0) {
-      TriangleHit th;
-      for (uint32_t i = e.child; i < e.child + e.count; ++i) {
-        if (intersect_triangle(shear, tris[i], ray.tnear, ray.tfar, th)) return true;
-      }
+      HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+      if (IntersectPack(bvh.packs()[e.child], shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) return true;
       continue;
     }
     const WideNode& n = nodes[e.child];
@@ -185,7 +256,8 @@ namespace {
 // index of the wide node made for `root`.
 class Collapser {
  public:
-  Collapser(const Bvh& bin, std::vector<WideNode>& out) : bin_(bin), out_(out) {}
+  Collapser(const Bvh& bin, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
+      : bin_(bin), out_(out), packs_(packs) {}
 
   uint32_t collapse(uint32_t root) {
     // Open the largest inner node until eight children (or only leaves) remain: keeps the
@@ -221,8 +293,12 @@ class Collapser {
     }
     for (size_t i = 0; i < kids.size(); ++i) {
       const BvhNode& n = bin_.nodes()[kids[i]];
-      uint32_t child = n.index, count = n.count;
-      if (!n.leaf()) child = collapse(kids[i]);  // may reallocate out_: index, not reference
+      uint32_t child = 0, count = n.count;
+      if (n.leaf()) {
+        child = make_pack(n.index, n.count);
+      } else {
+        child = collapse(kids[i]);  // may reallocate out_: index, not reference
+      }
       WideNode& w = out_[self];
       w.lo_x[i] = n.lo.x;
       w.lo_y[i] = n.lo.y;
@@ -237,19 +313,38 @@ class Collapser {
   }
 
  private:
+  uint32_t make_pack(uint32_t first, uint32_t count) {
+    TrianglePack p;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (int lane = 0; lane < kWideWidth; ++lane) {
+      const bool used = uint32_t(lane) < count;
+      const Triangle& t = bin_.triangles()[used ? first + uint32_t(lane) : first];
+      const Vec3 vs[3] = {t.v0, t.v1, t.v2};
+      for (int vtx = 0; vtx < 3; ++vtx) {
+        for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
+      }
+      p.slot[lane] = used ? first + uint32_t(lane) : 0xffffffffu;
+    }
+    packs_.push_back(p);
+    return static_cast<uint32_t>(packs_.size() - 1);
+  }
+
   const Bvh& bin_;
   std::vector<WideNode>& out_;
+  std::vector<TrianglePack>& packs_;
 };
 
 }  // namespace
 
-WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene) {
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_(&scene) {
+  BvhBuildOptions options = options_in;
+  options.max_leaf = std::min(options.max_leaf, kWideWidth);
   const Bvh binary(scene, options);
   tris_ = binary.triangles();
   ids_ = binary.triangle_ids();
   if (binary.nodes().empty()) return;
   nodes_.reserve(binary.nodes().size() / 4 + 1);
-  Collapser(binary, nodes_).collapse(0);
+  Collapser(binary, nodes_, packs_).collapse(0);
   empty_root_ = false;
 }
 
@@ -275,9 +370,18 @@ std::string WideBvh::validate() const {
       }
       if (!p.box.contains(box)) return "child box outside its parent's box";
       if (n.count[i] > 0) {
-        if (size_t(n.child[i]) + n.count[i] > tris_.size()) return "leaf range out of bounds";
-        for (uint32_t k = n.child[i]; k < n.child[i] + n.count[i]; ++k) {
-          if (!box.contains(tris_[k].bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
+        if (n.child[i] >= packs_.size() || n.count[i] > uint32_t(kWideWidth)) return "leaf pack out of range";
+        const TrianglePack& pk = packs_[n.child[i]];
+        for (uint32_t lane = 0; lane < uint32_t(kWideWidth); ++lane) {
+          if (lane >= n.count[i]) {
+            if (pk.slot[lane] != 0xffffffffu || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
+            continue;
+          }
+          const uint32_t k = pk.slot[lane];
+          if (k >= tris_.size()) return "pack slot out of range";
+          const Triangle& t = tris_[k];
+          if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
+          if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
           ++seen[ids_[k]];
         }
       } else {

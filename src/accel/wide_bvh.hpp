@@ -20,23 +20,33 @@ struct alignas(64) WideNode {
   float lo_x[kWideWidth], lo_y[kWideWidth], lo_z[kWideWidth];
   float hi_x[kWideWidth], hi_y[kWideWidth], hi_z[kWideWidth];
   uint32_t child[kWideWidth];  // inner child: node index; leaf child: first triangle
-  uint32_t count[kWideWidth];  // 0: inner child; > 0: leaf of `count` triangles
+  uint32_t count[kWideWidth];  // 0: inner child; > 0: leaf of `count` triangles in pack `child`
 };
 static_assert(sizeof(WideNode) == 256);
 
+// Up to eight triangles in SoA form, one per lane, tested against one ray in one SIMD pass.
+// Unused lanes hold NaN vertices, which fail every comparison and so never hit.
+struct alignas(64) TrianglePack {
+  float v[3][3][kWideWidth];  // [vertex][axis][lane]
+  uint32_t slot[kWideWidth];  // index into triangles()/triangle_ids(), or UINT32_MAX for padding
+};
+
 class WideBvh {
  public:
-  // Builds the binary SAH tree with `options`, then collapses it.
+  // Builds the binary SAH tree with `options` (leaves of up to eight triangles: one pack), then
+  // collapses it.
   WideBvh(const Scene& scene, const BvhBuildOptions& options);
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
+  const std::vector<TrianglePack>& packs() const { return packs_; }
   const std::vector<Triangle>& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }
   size_t memory_bytes() const {
-    return nodes_.size() * sizeof(WideNode) + tris_.size() * sizeof(Triangle) + ids_.size() * sizeof(uint32_t);
+    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) +
+           ids_.size() * sizeof(uint32_t);
   }
   // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf.
   std::string validate() const;
@@ -52,6 +62,7 @@ class WideBvh {
   friend struct WideBvhAccess;
   const Scene* scene_;
   std::vector<WideNode> nodes_;
+  std::vector<TrianglePack> packs_;
   std::vector<Triangle> tris_;
   std::vector<uint32_t> ids_;
   bool empty_root_ = true;

@@ -58,7 +58,8 @@ const std::vector<Variant>& all_variants() {
       {"async+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Async, "SAH BVH (TBB build), std::async per row", false},
       {"lq+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Queue, "SAH BVH (TBB build), locked queue of 64-pixel blocks", false},
       {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic, "SAH BVH (TBB build), atomic tile counter", false},
-      {"best", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
+      {"tbb+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
+      {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), TBB work stealing", false},
       {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "Intel Embree 3, TBB work stealing", false},
   };
   return v;
