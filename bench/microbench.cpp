@@ -135,6 +135,7 @@ void register_dynamic() {
     AccelOptions median;
     median.bvh.split = BvhSplit::Median;
     accels.emplace_back("bvh-median", median);
+    accels.emplace_back("bvh8", AccelOptions{.kind = AccelKind::Bvh8});
     if (embree_available()) accels.emplace_back("embree", AccelOptions{.kind = AccelKind::Embree});
     for (const auto& [accel_name, options] : accels) {
       auto accel = std::make_shared<Accelerator>(build_accelerator(*c.scene, options));

@@ -19,6 +19,7 @@ mkdir -p "$O"
   free -h | head -2
   echo "compiler: $(c++ --version | head -1)"
   echo "embree: $(dpkg-query -W -f='${Version}' libembree-dev 2>/dev/null), tbb: $(dpkg-query -W -f='${Version}' libtbb-dev 2>/dev/null)"
+  echo "SIMD target chosen by tracer: $($T render --accel bvh8 --width 4 --height 4 -q --stats -o /tmp/tracer-target.png | grep accel)"
   echo "date: $(date -u +%Y-%m-%d)"
   echo '```'
 } > "$O/machine.md"
