@@ -69,6 +69,9 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --no-such-flag", 2, "--no-such-flag"},
       {"frobnicate", 2, "unknown command 'frobnicate'"},
       {"render --width 20000", 2, "--width: must be between 1 and 16384, got 20000"},
+      {"render --simd maybe", 2, "--simd: expected auto or off, got 'maybe'"},
+      {"render --accel bvh8 --simd off", 2, "--simd off: bvh8 is the SIMD tree"},
+      {"render --simd-target neon", 2, "--simd-target: unknown target 'neon'"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
   };
   for (const CliCase& c : cases) {

@@ -125,5 +125,41 @@ TEST(WideBvh, WatertightClosedSphere) {
   }
 }
 
+TEST(SimdBruteForce, AgreesWithScalarBruteForceOnEveryTarget) {
+  TargetGuard guard;
+  std::vector<Scene> scenes;
+  scenes.push_back(make_cornell_box(300));
+  const Triangle t{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  scenes.push_back(test::scene_of({t}));                                   // one pack, seven padding lanes
+  scenes.push_back(test::scene_of(std::vector<Triangle>(17, t)));          // ties across packs
+  if (test::have_shared_scenes()) scenes.push_back(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
+  for (const std::string& target : targets()) {
+    ASSERT_TRUE(WideBvh::force_simd_target(target));
+    for (const Scene& scene : scenes) {
+      SCOPED_TRACE(target + " " + scene.source + " " + std::to_string(scene.size()));
+      const BruteForce scalar(scene);
+      const SimdBruteForce simd(scene);
+      std::vector<Ray> rays = test::random_rays(scene, 3000, 11);
+      for (size_t i = 0; i < scene.size(); i += 3) {  // straight at triangles, and from their surfaces
+        Ray r;
+        r.org = scene.triangles[i].centroid() + Vec3{0.01f, 0.02f, 3.0f};
+        r.dir = normalize(scene.triangles[i].centroid() - r.org);
+        rays.push_back(r);
+        r.org = scene.triangles[i].centroid();
+        r.dir = normalize(scene.triangles[i].normal());
+        rays.push_back(r);
+      }
+      size_t bad = 0;
+      for (const Ray& r : rays) {
+        Hit a, b;
+        const bool ha = scalar.intersect(r, a), hb = simd.intersect(r, b);
+        if (ha != hb || a.tri != b.tri || (ha && (a.t != b.t || a.u != b.u || a.v != b.v))) ++bad;
+        if (scalar.occluded(r) != simd.occluded(r)) ++bad;
+      }
+      EXPECT_EQ(bad, 0u) << "of " << rays.size();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tracer

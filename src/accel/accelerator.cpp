@@ -9,6 +9,7 @@ namespace tracer {
 static_assert(RayAccelerator<BruteForce>);
 static_assert(RayAccelerator<Bvh>);
 static_assert(RayAccelerator<WideBvh>);
+static_assert(RayAccelerator<SimdBruteForce>);
 
 bool embree_available() {
 #ifdef TRACER_HAVE_EMBREE
@@ -29,6 +30,10 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
     case AccelKind::Brute:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<BruteForce>, scene);
       acc.name = "brute";
+      break;
+    case AccelKind::BruteSimd:
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<SimdBruteForce>, scene);
+      acc.name = "brute-simd-" + WideBvh::simd_target();
       break;
     case AccelKind::Bvh:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);

@@ -24,14 +24,14 @@ concept RayAccelerator = requires(const A& a, const Ray& r, Hit& h) {
   { a.occluded(r) } -> std::same_as<bool>;
 };
 
-enum class AccelKind { Brute, Bvh, Bvh8, Embree };
+enum class AccelKind { Brute, BruteSimd, Bvh, Bvh8, Embree };
 
 struct AccelOptions {
   AccelKind kind = AccelKind::Bvh;
   BvhBuildOptions bvh;
 };
 
-using AccelVariant = std::variant<BruteForce, Bvh, WideBvh
+using AccelVariant = std::variant<BruteForce, SimdBruteForce, Bvh, WideBvh
 #ifdef TRACER_HAVE_EMBREE
                                   , EmbreeAccel
 #endif

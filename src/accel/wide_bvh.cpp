@@ -217,6 +217,42 @@ bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
   return false;
 }
 
+// Brute force over packs: closest hit, ties to the lower scene index as everywhere.
+bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
+  hit = Hit{};
+  hit.t = ray.tfar;
+  const RayShear shear(ray);
+  const Triangle* tris = bf.triangles().data();
+  const uint32_t* ids = bf.triangle_ids().data();
+  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  for (const TrianglePack& p : bf.packs()) {
+    for (uint32_t bits = IntersectPack(p, shear, tris, ray.tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      const uint32_t id = ids[p.slot[k]];
+      if (closer(tt[k], id, hit)) {
+        hit.t = tt[k];
+        hit.u = uu[k];
+        hit.v = vv[k];
+        hit.tri = id;
+      }
+    }
+  }
+  if (!hit.valid()) return false;
+  hit.geomID = bf.scene().tri_geom[hit.tri];
+  hit.primID = bf.scene().tri_prim[hit.tri];
+  return true;
+}
+
+bool OccludedBrute(const SimdBruteForce& bf, const Ray& ray) {
+  const RayShear shear(ray);
+  const Triangle* tris = bf.triangles().data();
+  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  for (const TrianglePack& p : bf.packs()) {
+    if (IntersectPack(p, shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) return true;
+  }
+  return false;
+}
+
 int64_t CurrentTarget() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -229,6 +265,37 @@ namespace tracer {
 HWY_EXPORT(IntersectWide);
 HWY_EXPORT(OccludedWide);
 HWY_EXPORT(CurrentTarget);
+HWY_EXPORT(IntersectBrute);
+HWY_EXPORT(OccludedBrute);
+
+bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectBrute)(*this, ray, hit); }
+bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
+
+SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
+  for (uint32_t i = 0; i < scene.size(); ++i) {
+    if (scene.triangles[i].degenerate()) continue;
+    tris_.push_back(scene.triangles[i]);
+    ids_.push_back(i);
+  }
+  for (uint32_t first = 0; first < tris_.size(); first += kWideWidth) {
+    packs_.push_back(make_triangle_pack(tris_, first, std::min<uint32_t>(kWideWidth, uint32_t(tris_.size()) - first)));
+  }
+}
+
+TrianglePack make_triangle_pack(const std::vector<Triangle>& triangles, uint32_t first, uint32_t count) {
+  TrianglePack p;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int lane = 0; lane < kWideWidth; ++lane) {
+    const bool used = uint32_t(lane) < count;
+    const Triangle& t = triangles[used ? first + uint32_t(lane) : first];
+    const Vec3 vs[3] = {t.v0, t.v1, t.v2};
+    for (int vtx = 0; vtx < 3; ++vtx) {
+      for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
+    }
+    p.slot[lane] = used ? first + uint32_t(lane) : 0xffffffffu;
+  }
+  return p;
+}
 
 // One table-indexed call per ray (Highway's dynamic dispatch), never per node: the kernels above
 // inline the whole traversal.
@@ -314,18 +381,7 @@ class Collapser {
 
  private:
   uint32_t make_pack(uint32_t first, uint32_t count) {
-    TrianglePack p;
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    for (int lane = 0; lane < kWideWidth; ++lane) {
-      const bool used = uint32_t(lane) < count;
-      const Triangle& t = bin_.triangles()[used ? first + uint32_t(lane) : first];
-      const Vec3 vs[3] = {t.v0, t.v1, t.v2};
-      for (int vtx = 0; vtx < 3; ++vtx) {
-        for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
-      }
-      p.slot[lane] = used ? first + uint32_t(lane) : 0xffffffffu;
-    }
-    packs_.push_back(p);
+    packs_.push_back(make_triangle_pack(bin_.triangles(), first, count));
     return static_cast<uint32_t>(packs_.size() - 1);
   }
 

@@ -68,4 +68,30 @@ class WideBvh {
   bool empty_root_ = true;
 };
 
+// The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight
+// at a time, through the same pack kernel as the wide BVH's leaves.
+class SimdBruteForce {
+ public:
+  explicit SimdBruteForce(const Scene& scene);
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+  const std::vector<TrianglePack>& packs() const { return packs_; }
+  const std::vector<Triangle>& triangles() const { return tris_; }
+  const std::vector<uint32_t>& triangle_ids() const { return ids_; }
+  const Scene& scene() const { return *scene_; }
+  size_t memory_bytes() const {
+    return packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) + ids_.size() * sizeof(uint32_t);
+  }
+
+ private:
+  const Scene* scene_;
+  std::vector<TrianglePack> packs_;
+  std::vector<Triangle> tris_;
+  std::vector<uint32_t> ids_;
+};
+
+// Packs triangles[first, first+count) (count <= 8) into one TrianglePack; `slot` indices are
+// first + lane, padding lanes are NaN.
+TrianglePack make_triangle_pack(const std::vector<Triangle>& triangles, uint32_t first, uint32_t count);
+
 }  // namespace tracer

@@ -34,6 +34,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
   app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
   app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
+  app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")->capture_default_str();
   app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
@@ -122,8 +123,11 @@ RenderSettings settings_for(const RenderArgs& a) {
 AccelOptions accel_options_for(const RenderArgs& a) {
   AccelOptions o;
   const std::string accel = lower(a.accel);
-  if (accel == "brute") o.kind = AccelKind::Brute;
+  const std::string simd = lower(a.simd);
+  if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
+  if (accel == "brute") o.kind = simd == "auto" ? AccelKind::BruteSimd : AccelKind::Brute;
   else if (accel == "bvh") o.kind = AccelKind::Bvh;
+  else if (accel == "bvh8" && simd == "off") throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
   else if (accel == "bvh8") o.kind = AccelKind::Bvh8;
   else if (accel == "embree") o.kind = AccelKind::Embree;
   else throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, bvh8, embree)");

@@ -34,6 +34,7 @@ struct RenderArgs {
   unsigned seed = 0;
   std::string accel = "bvh", split = "sah", build = "tasks";
   int max_leaf = 4, bins = 16;
+  std::string simd = "auto";
   std::string simd_target = "auto";
   std::string sched = "tbb";
   std::optional<int> threads;
