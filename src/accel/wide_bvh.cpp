@@ -129,6 +129,22 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
   return bits;
 }
 
+// Updates `hit` with the closest lane of `pack` (ties to the lower scene index, as everywhere).
+HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, const uint32_t* ids, float tnear,
+                              Hit& hit) {
+  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  for (uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    const uint32_t id = ids[p.slot[k]];
+    if (closer(tt[k], id, hit)) {
+      hit.t = tt[k];
+      hit.u = uu[k];
+      hit.v = vv[k];
+      hit.tri = id;
+    }
+  }
+}
+
 struct StackEntry {
   uint32_t child, count;
   float t;
@@ -170,18 +186,7 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
     const StackEntry e = stack[--sp];
     if (!(e.t <= hit.t * RayBoxTest::kTieGuard)) continue;
     if (e.count > 0) {
-      const TrianglePack& p = bvh.packs()[e.child];
-      HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
-      for (uint32_t bits = IntersectPack(p, shear, tris, ray.tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
-        const int k = __builtin_ctz(bits);
-        const uint32_t id = ids[p.slot[k]];
-        if (closer(tt[k], id, hit)) {
-          hit.t = tt[k];
-          hit.u = uu[k];
-          hit.v = vv[k];
-          hit.tri = id;
-        }
-      }
+      ClosestInPack(bvh.packs()[e.child], shear, tris, ids, ray.tnear, hit);
       continue;
     }
     const WideNode& n = nodes[e.child];
@@ -224,19 +229,7 @@ bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
   const RayShear shear(ray);
   const Triangle* tris = bf.triangles().data();
   const uint32_t* ids = bf.triangle_ids().data();
-  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
-  for (const TrianglePack& p : bf.packs()) {
-    for (uint32_t bits = IntersectPack(p, shear, tris, ray.tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
-      const int k = __builtin_ctz(bits);
-      const uint32_t id = ids[p.slot[k]];
-      if (closer(tt[k], id, hit)) {
-        hit.t = tt[k];
-        hit.u = uu[k];
-        hit.v = vv[k];
-        hit.tri = id;
-      }
-    }
-  }
+  for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ids, ray.tnear, hit);
   if (!hit.valid()) return false;
   hit.geomID = bf.scene().tri_geom[hit.tri];
   hit.primID = bf.scene().tri_prim[hit.tri];
