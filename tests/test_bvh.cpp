@@ -126,9 +126,12 @@ void check_scene_against_brute(const Scene& scene, size_t random_count, int imag
 
 TEST(BvhAgreement, CornellScenesMatchBruteForce) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
-  for (const char* name : {"Original", "Mirror", "Sphere", "Water", "Glossy", "Empty-CO"}) {
+  // Every Cornell file in ../shared/scenes/cornell-box (the water surface alone too).
+  for (const char* name : {"CornellBox-Original", "CornellBox-Mirror", "CornellBox-Sphere", "CornellBox-Water", "CornellBox-Glossy",
+                           "CornellBox-Glossy-Floor", "CornellBox-Empty-CO", "CornellBox-Empty-RG", "CornellBox-Empty-Squashed",
+                           "CornellBox-Empty-White", "water"}) {
     SCOPED_TRACE(name);
-    const Scene scene = load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
+    const Scene scene = load_obj(test::scene_path(std::string("cornell-box/") + name + ".obj"), [](const std::string&) {});
     check_scene_against_brute(scene, test::ray_budget(100'000), 32);
   }
 }
