@@ -24,15 +24,12 @@ struct RecordedRays {
 struct Recorder {
   const Bvh* bvh;
   RecordedRays* out;
-  int ao_samples;
-  mutable int pending_shadow = 0;
   bool intersect(const Ray& r, Hit& h) const {
     out->primary.push_back(r);
     return bvh->intersect(r, h);
   }
   bool occluded(const Ray& r) const {
-    // shade_pixel traces the shadow rays first, then the AO rays, which are the ones with the
-    // AO tfar; distinguish by tfar (finite for shadow rays, infinite for AO rays here).
+    // Shadow rays stop short of their light (finite tfar); AO rays here have tfar = infinity.
     (r.tfar == kInfinity ? out->ao : out->shadow).push_back(r);
     return bvh->occluded(r);
   }
@@ -59,7 +56,7 @@ std::vector<SceneCase>& cases() {
       Framebuffer fb(rs.width, rs.height);
       const CameraSpec cam = c.scene->camera ? *c.scene->camera : frame_bounds(c.scene->bounds);
       RenderContext ctx{c.scene.get(), Camera(cam, rs.width, rs.height), rs, &fb};
-      Recorder rec{c.bvh.get(), &c.rays, rs.ao_samples};
+      Recorder rec{c.bvh.get(), &c.rays};
       render_tile(rec, ctx, Tile{0, 0, rs.width, rs.height});
       v.push_back(std::move(c));
     };

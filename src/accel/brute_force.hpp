@@ -23,10 +23,7 @@ class BruteForce {
     hit = Hit{};
     hit.t = ray.tfar;
     intersect_range(shear, tris_.data(), ids_.data(), 0, static_cast<uint32_t>(tris_.size()), ray.tnear, hit);
-    if (!hit.valid()) return false;
-    hit.geomID = scene_->tri_geom[hit.tri];
-    hit.primID = scene_->tri_prim[hit.tri];
-    return true;
+    return finish_hit(*scene_, hit);
   }
 
   bool occluded(const Ray& ray) const {

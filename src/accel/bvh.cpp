@@ -48,10 +48,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
     }
   }
 done:
-  if (!hit.valid()) return false;
-  hit.geomID = scene_->tri_geom[hit.tri];
-  hit.primID = scene_->tri_prim[hit.tri];
-  return true;
+  return finish_hit(*scene_, hit);
 }
 
 bool Bvh::occluded(const Ray& ray) const {

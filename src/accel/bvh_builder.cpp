@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "accel/bvh.hpp"
+#include "sched/thread_count.hpp"
 
 namespace tracer {
 namespace {
@@ -73,17 +74,6 @@ struct Bounds4 {
   Aabb centroids() const { return Aabb{{clo[0], clo[1], clo[2]}, {chi[0], chi[1], chi[2]}}; }
 };
 
-struct Bounds2 {
-  Aabb box, centroids;
-  void join(const Bounds2& o) {
-    box.extend(o.box);
-    centroids.extend(o.centroids);
-  }
-};
-
-int resolve_threads(int threads) {
-  return threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-}
 
 class BvhBuilder {
  public:
@@ -93,13 +83,12 @@ class BvhBuilder {
     for (uint32_t i = 0; i < scene.size(); ++i) {
       if (!scene.triangles[i].degenerate()) prims_.push_back(i);
     }
-    boxes_.resize(scene.size());
     centroids_.resize(scene.size());
     box4_.resize(scene.size());
     for (uint32_t i : prims_) {
-      boxes_[i] = scene.triangles[i].bounds();
-      centroids_[i] = boxes_[i].center();  // box centre, not vertex mean: it is what binning sees
-      box4_[i] = Box4{{boxes_[i].lo.x, boxes_[i].lo.y, boxes_[i].lo.z, 0.0f}, {boxes_[i].hi.x, boxes_[i].hi.y, boxes_[i].hi.z, 0.0f}};
+      const Aabb b = scene.triangles[i].bounds();
+      centroids_[i] = b.center();  // box centre, not vertex mean: it is what binning sees
+      box4_[i] = Box4{{b.lo.x, b.lo.y, b.lo.z, 0.0f}, {b.hi.x, b.hi.y, b.hi.z, 0.0f}};
     }
     scratch_.resize(prims_.size());
     nodes_.resize(std::max<size_t>(1, 2 * prims_.size()));
@@ -109,7 +98,7 @@ class BvhBuilder {
     if (prims_.empty()) return;
     nodes_[0] = BuildNode{{}, 0, uint32_t(prims_.size()), kNone, 0};
     node_count_ = 1;
-    const int threads = resolve_threads(options_.threads);
+    const int threads = resolve_thread_count(options_.threads);
     switch (options_.mode) {
       case BuildMode::Seq: build_seq(0); break;
       case BuildMode::Async: build_async(0, async_depth_limit(threads)); break;
@@ -276,7 +265,6 @@ class BvhBuilder {
       node.cbox = b.centroids();
       node.bounds_known = true;
     }
-    const Bounds2 bounds{node.box, node.cbox};
     uint32_t mid;
     Bounds4 child_bounds[2];
     bool children_known = false;
@@ -285,20 +273,20 @@ class BvhBuilder {
       mid = median_split(begin, end, static_cast<int>(node.depth % 3));
     } else {
       if (count <= 1) return false;
-      const Vec3 extent = bounds.centroids.extent();
+      const Vec3 extent = node.cbox.extent();
       if (node.depth >= kMedianFallbackDepth || max_component(extent) <= 0.0f) {
         // Nothing to bin (all centroids equal) or pathologically deep: halve by count.
         if (count <= uint32_t(options_.max_leaf) && max_component(extent) <= 0.0f) return false;
         mid = median_split(begin, end, max_dimension(extent));
       } else {
-        const auto sah = sah_split(node, bounds.centroids, parallel);
+        const auto sah = sah_split(node, node.cbox, parallel);
         if (sah.axis < 0) {
           if (count <= uint32_t(options_.max_leaf)) return false;
           mid = median_split(begin, end, max_dimension(extent));
         } else {
           const float leaf_cost = options_.intersection_cost * float(count);
           if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
-          const Binner binner(bounds.centroids, sah.bins);
+          const Binner binner(node.cbox, sah.bins);
           Bounds4 lb, rb;
           mid = partition(begin, end, begin + sah.left_count, parallel, lb, rb, [&](uint32_t prim) {
             return binner(centroids_[prim][sah.axis], sah.axis) < sah.split_bin;
@@ -500,7 +488,6 @@ class BvhBuilder {
 
   BvhBuildOptions options_;
   std::vector<uint32_t> prims_, scratch_;
-  std::vector<Aabb> boxes_;
   std::vector<Box4> box4_;
   std::vector<Vec3> centroids_;
   std::vector<BuildNode> nodes_;

@@ -68,6 +68,14 @@ inline bool closer(float t, uint32_t tri, const Hit& best) {
   return t < best.t || (t == best.t && tri < best.tri);
 }
 
+// Ends a closest-hit query: names the hit triangle by geomID/primID; false if nothing was hit.
+inline bool finish_hit(const Scene& scene, Hit& hit) {
+  if (!hit.valid()) return false;
+  hit.geomID = scene.tri_geom[hit.tri];
+  hit.primID = scene.tri_prim[hit.tri];
+  return true;
+}
+
 // Closest hit among tris[begin, end) whose scene indices are ids[...]: updates `hit` (t, u, v,
 // tri) where a triangle is closer. The leaf loop of every scalar accelerator.
 inline void intersect_range(const RayShear& shear, const Triangle* tris, const uint32_t* ids, uint32_t begin, uint32_t end,

@@ -193,10 +193,7 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
     const uint32_t bits = TestChildren(n, wr, ray.tnear, hit.t, t);
     PushSorted(n, bits, t, stack, sp);
   }
-  if (!hit.valid()) return false;
-  hit.geomID = bvh.scene().tri_geom[hit.tri];
-  hit.primID = bvh.scene().tri_prim[hit.tri];
-  return true;
+  return finish_hit(bvh.scene(), hit);
 }
 
 bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
@@ -230,10 +227,7 @@ bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
   const Triangle* tris = bf.triangles().data();
   const uint32_t* ids = bf.triangle_ids().data();
   for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ids, ray.tnear, hit);
-  if (!hit.valid()) return false;
-  hit.geomID = bf.scene().tri_geom[hit.tri];
-  hit.primID = bf.scene().tri_prim[hit.tri];
-  return true;
+  return finish_hit(bf.scene(), hit);
 }
 
 bool OccludedBrute(const SimdBruteForce& bf, const Ray& ray) {
@@ -394,7 +388,6 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_
   if (binary.nodes().empty()) return;
   nodes_.reserve(binary.nodes().size() / 4 + 1);
   Collapser(binary, nodes_, packs_).collapse(0);
-  empty_root_ = false;
 }
 
 std::string WideBvh::validate() const {

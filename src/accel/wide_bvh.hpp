@@ -59,13 +59,11 @@ class WideBvh {
   static bool force_simd_target(const std::string& name);
 
  private:
-  friend struct WideBvhAccess;
   const Scene* scene_;
   std::vector<WideNode> nodes_;
   std::vector<TrianglePack> packs_;
   std::vector<Triangle> tris_;
   std::vector<uint32_t> ids_;
-  bool empty_root_ = true;
 };
 
 // The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight

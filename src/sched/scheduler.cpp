@@ -14,10 +14,6 @@
 
 namespace tracer {
 
-int resolve_thread_count(int threads) {
-  return threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-}
-
 namespace {
 
 // Renders one tile: the only place the accelerator variant is dispatched.

@@ -9,6 +9,7 @@
 
 #include "accel/accelerator.hpp"
 #include "render/shading.hpp"
+#include "sched/thread_count.hpp"
 
 namespace tracer {
 
@@ -36,8 +37,6 @@ struct RenderControl {
   std::function<void(const Tile&)> on_tile;     // test hook, called once per rendered tile
   bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
 };
-
-int resolve_thread_count(int threads);
 
 // Renders ctx.framebuffer with `accel`. Returns false if cancelled before finishing (tiles not
 // reached are left untouched).
