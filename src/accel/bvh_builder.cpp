@@ -18,7 +18,11 @@
 #include <deque>
 #include <future>
 #include <mutex>
+#include <cstdlib>
+#include <memory>
 #include <thread>
+
+#include <immintrin.h>  // SSE2, part of every x86-64
 
 #include "accel/bvh.hpp"
 #include "sched/thread_count.hpp"
@@ -40,63 +44,103 @@ struct BuildNode {
   uint32_t depth = 0;
   Aabb cbox;                  // bounds of the centroids
   bool bounds_known = false;  // box and cbox already computed by the parent's partition pass
+  uint8_t buffer = 0;         // which of the two PrimRef buffers holds [begin, end)
 };
 
-// A triangle's box padded to four lanes for the binning loop.
-struct alignas(32) Box4 {
-  float lo[4], hi[4];
-};
-
-// Box and centroid bounds accumulated four lanes at a time (vectorised min/max).
-struct Bounds4 {
-  float lo[4], hi[4], clo[4], chi[4];
-  Bounds4() {
-    for (int k = 0; k < 4; ++k) { lo[k] = clo[k] = kInfinity; hi[k] = chi[k] = -kInfinity; }
+// One primitive as the builder moves it around: its box in two SSE registers, the triangle's
+// scene index in the otherwise unused fourth lane of `lo`. Binning and partitioning stream
+// through one array of these, so no pass gathers from per-triangle arrays in random order.
+struct alignas(32) PrimRef {
+  __m128 lo, hi;  // lane 3 of hi is 0
+  static PrimRef make(const Aabb& b, uint32_t id) {
+    return {_mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, std::bit_cast<float>(id)), _mm_setr_ps(b.hi.x, b.hi.y, b.hi.z, 0.0f)};
   }
-  void add(const Box4& box) {
-    for (int k = 0; k < 4; ++k) {
-      const float c = (box.lo[k] + box.hi[k]) * 0.5f;  // = Aabb::center(), the binning centroid
-      lo[k] = box.lo[k] < lo[k] ? box.lo[k] : lo[k];
-      hi[k] = box.hi[k] > hi[k] ? box.hi[k] : hi[k];
-      clo[k] = c < clo[k] ? c : clo[k];
-      chi[k] = c > chi[k] ? c : chi[k];
-    }
+  uint32_t id() const { return std::bit_cast<uint32_t>(_mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3)))); }
+  // (lo + hi) / 2 per axis, as Aabb::center() computes it; lane 3 is masked off first so the
+  // id's bits never enter arithmetic (they may look like a denormal).
+  __m128 center() const {
+    const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    return _mm_mul_ps(_mm_add_ps(_mm_and_ps(lo, xyz), hi), _mm_set1_ps(0.5f));
+  }
+  float center(int axis) const {
+    alignas(16) float c[4];
+    _mm_store_ps(c, center());
+    return c[axis];
+  }
+};
+static_assert(sizeof(PrimRef) == 32);
+
+// Box and centroid bounds accumulated four lanes at a time; lane 3 is meaningless.
+struct Bounds4 {
+  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  __m128 clo = _mm_set1_ps(kInfinity), chi = _mm_set1_ps(-kInfinity);
+  void add(const PrimRef& r) {
+    const __m128 c = r.center();
+    lo = _mm_min_ps(lo, r.lo);
+    hi = _mm_max_ps(hi, r.hi);
+    clo = _mm_min_ps(clo, c);
+    chi = _mm_max_ps(chi, c);
   }
   void join(const Bounds4& o) {
-    for (int k = 0; k < 4; ++k) {
-      lo[k] = o.lo[k] < lo[k] ? o.lo[k] : lo[k];
-      hi[k] = o.hi[k] > hi[k] ? o.hi[k] : hi[k];
-      clo[k] = o.clo[k] < clo[k] ? o.clo[k] : clo[k];
-      chi[k] = o.chi[k] > chi[k] ? o.chi[k] : chi[k];
-    }
+    lo = _mm_min_ps(lo, o.lo);
+    hi = _mm_max_ps(hi, o.hi);
+    clo = _mm_min_ps(clo, o.clo);
+    chi = _mm_max_ps(chi, o.chi);
   }
-  Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
-  Aabb centroids() const { return Aabb{{clo[0], clo[1], clo[2]}, {chi[0], chi[1], chi[2]}}; }
+  static Aabb to_aabb(__m128 l, __m128 h) {
+    alignas(16) float a[4], b[4];
+    _mm_store_ps(a, l);
+    _mm_store_ps(b, h);
+    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
+  }
+  Aabb box() const { return to_aabb(lo, hi); }
+  Aabb centroids() const { return to_aabb(clo, chi); }
 };
-
 
 class BvhBuilder {
  public:
   BvhBuilder(const Scene& scene, const BvhBuildOptions& options) : options_(options) {
     options_.bins = std::clamp(options_.bins, 2, kMaxBins);
     options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
-    for (uint32_t i = 0; i < scene.size(); ++i) {
-      if (!scene.triangles[i].degenerate()) prims_.push_back(i);
+    const auto n = static_cast<uint32_t>(scene.size());
+    // Left uninitialised (trivial types; implicit-lifetime BuildNodes from malloc): every slot
+    // is written before it is read, and zeroing 2N nodes cost more than the top-level splits.
+    for (auto& b : buffers_) b = std::make_unique_for_overwrite<PrimRef[]>(n);
+    PrimRef* refs = buffers_[0].get();
+    nodes_.reset(static_cast<BuildNode*>(std::malloc(std::max<size_t>(1, 2 * size_t(n)) * sizeof(BuildNode))));
+    if (!nodes_) throw std::bad_alloc();
+    // Degenerate triangles are left out. In parallel: count per block, then fill at the offsets.
+    const auto fill = [&](uint32_t b, uint32_t e, uint32_t out) {
+      for (uint32_t i = b; i < e; ++i) {
+        if (!scene.triangles[i].degenerate()) refs[out++] = PrimRef::make(scene.triangles[i].bounds(), i);
+      }
+      return out;
+    };
+    if (options_.mode != BuildMode::Tasks || n < kParallelSplit) {
+      count_ = fill(0, n, 0);
+      return;
     }
-    centroids_.resize(scene.size());
-    box4_.resize(scene.size());
-    for (uint32_t i : prims_) {
-      const Aabb b = scene.triangles[i].bounds();
-      centroids_[i] = b.center();  // box centre, not vertex mean: it is what binning sees
-      box4_[i] = Box4{{b.lo.x, b.lo.y, b.lo.z, 0.0f}, {b.hi.x, b.hi.y, b.hi.z, 0.0f}};
-    }
-    scratch_.resize(prims_.size());
-    nodes_.resize(std::max<size_t>(1, 2 * prims_.size()));
+    const uint32_t blocks = (n + kPartitionBlock - 1) / kPartitionBlock;
+    std::vector<uint32_t> offsets(blocks + 1, 0);
+    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
+      uint32_t c = 0;
+      for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i) c += scene.triangles[i].degenerate() ? 0 : 1;
+      offsets[k + 1] = c;
+      publish();
+    });
+    publish();
+    for (uint32_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
+    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
+      fill(k * kPartitionBlock, std::min(n, (k + 1) * kPartitionBlock), offsets[k]);
+      publish();
+    });
+    publish();
+    count_ = offsets[blocks];
   }
 
   void build() {
-    if (prims_.empty()) return;
-    nodes_[0] = BuildNode{{}, 0, uint32_t(prims_.size()), kNone, 0};
+    if (count_ == 0) return;
+    nodes_[0] = BuildNode{{}, 0, count_, kNone, 0};
     node_count_ = 1;
     const int threads = resolve_thread_count(options_.threads);
     switch (options_.mode) {
@@ -104,26 +148,27 @@ class BvhBuilder {
       case BuildMode::Async: build_async(0, async_depth_limit(threads)); break;
       case BuildMode::Queue: build_queue(threads); break;
       case BuildMode::Tasks: {
-        tbb::task_arena arena(threads);
-        arena.execute([&] { build_tasks(0); });
+        build_tasks(0);  // inside the caller's task arena
         publish();
         break;
       }
     }
   }
 
-  // Depth-first flattening into the final layout: children adjacent, leaves pointing into prims_.
-  void flatten(BvhNodeArray& out) const {
-    out.clear();
-    if (prims_.empty()) return;
-    out.reserve(node_count_.load() + 1);
-    out.push_back({});
-    out.push_back(BvhNode{{}, 0, {}, 0});  // padding: children pairs start at even indices
+  // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
+  // triangle index of every leaf slot.
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids) const {
+    ids.resize(count_);
+    out.resize(count_ == 0 ? 0 : node_count_.load() + 1);  // + the padding node
+    if (count_ == 0) return;
+    out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
     struct Item { uint32_t build, flat; };
-    std::vector<Item> stack{{0, 0}};
-    while (!stack.empty()) {
-      const Item it = stack.back();
-      stack.pop_back();
+    Item stack[2 * Bvh::kMaxDepth + 2];
+    int sp = 0;
+    stack[sp++] = {0, 0};
+    uint32_t next = 2;
+    while (sp > 0) {
+      const Item it = stack[--sp];
       const BuildNode& n = nodes_[it.build];
       BvhNode& f = out[it.flat];
       f.lo = n.box.lo;
@@ -131,20 +176,18 @@ class BvhBuilder {
       if (n.left == kNone) {
         f.index = n.begin;
         f.count = n.end - n.begin;
+        const PrimRef* refs = buffers_[n.buffer].get();
+        for (uint32_t i = n.begin; i < n.end; ++i) ids[i] = refs[i].id();
       } else {
-        const auto first = static_cast<uint32_t>(out.size());
-        f.index = first;
+        f.index = next;
         f.count = 0;
-        out.push_back({});
-        out.push_back({});
         // Push right first so the left subtree is laid out right after its parent.
-        stack.push_back({n.left + 1, first + 1});
-        stack.push_back({n.left, first});
+        stack[sp++] = {n.left + 1, next + 1};
+        stack[sp++] = {n.left, next};
+        next += 2;
       }
     }
   }
-
-  const std::vector<uint32_t>& prims() const { return prims_; }
 
  private:
   static int async_depth_limit(int threads) {
@@ -256,9 +299,11 @@ class BvhBuilder {
   bool split(uint32_t id, bool parallel) {
     BuildNode& node = nodes_[id];
     const uint32_t begin = node.begin, end = node.end, count = end - begin;
+    PrimRef* refs = buffers_[node.buffer].get();
+    uint8_t child_buffer = node.buffer;  // partitions move the children to the other buffer
     if (!node.bounds_known) {
       const Bounds4 b = reduce_range(begin, end, parallel, Bounds4{}, [&](uint32_t from, uint32_t to, Bounds4 acc) {
-        for (uint32_t i = from; i < to; ++i) acc.add(box4_[prims_[i]]);
+        for (uint32_t i = from; i < to; ++i) acc.add(refs[i]);
         return acc;
       });
       node.box = b.box();
@@ -270,26 +315,27 @@ class BvhBuilder {
     bool children_known = false;
     if (options_.split == BvhSplit::Median) {
       if (count <= 2) return false;  // the study's leaves of one or two triangles
-      mid = median_split(begin, end, static_cast<int>(node.depth % 3));
+      mid = median_split(refs, begin, end, static_cast<int>(node.depth % 3));
     } else {
       if (count <= 1) return false;
       const Vec3 extent = node.cbox.extent();
       if (node.depth >= kMedianFallbackDepth || max_component(extent) <= 0.0f) {
         // Nothing to bin (all centroids equal) or pathologically deep: halve by count.
         if (count <= uint32_t(options_.max_leaf) && max_component(extent) <= 0.0f) return false;
-        mid = median_split(begin, end, max_dimension(extent));
+        mid = median_split(refs, begin, end, max_dimension(extent));
       } else {
-        const auto sah = sah_split(node, node.cbox, parallel);
+        const auto sah = sah_split(refs, node, node.cbox, parallel);
         if (sah.axis < 0) {
           if (count <= uint32_t(options_.max_leaf)) return false;
-          mid = median_split(begin, end, max_dimension(extent));
+          mid = median_split(refs, begin, end, max_dimension(extent));
         } else {
           const float leaf_cost = options_.intersection_cost * float(count);
           if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
           const Binner binner(node.cbox, sah.bins);
           Bounds4 lb, rb;
-          mid = partition(begin, end, begin + sah.left_count, parallel, lb, rb, [&](uint32_t prim) {
-            return binner(centroids_[prim][sah.axis], sah.axis) < sah.split_bin;
+          child_buffer = uint8_t(1 - node.buffer);
+          mid = partition(refs, buffers_[child_buffer].get(), begin, end, begin + sah.left_count, parallel, lb, rb, [&](const PrimRef& prim) {
+            return binner(prim.center(sah.axis), sah.axis) < sah.split_bin;
           });
           child_bounds[0] = lb;
           child_bounds[1] = rb;
@@ -307,16 +353,17 @@ class BvhBuilder {
         nodes_[left + c].bounds_known = true;
       }
     }
+    nodes_[left].buffer = nodes_[left + 1].buffer = child_buffer;
     node.left = left;
     return true;
   }
 
-  uint32_t median_split(uint32_t begin, uint32_t end, int axis) {
+  uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis) {
     const uint32_t mid = begin + (end - begin) / 2;
     // Ties broken by triangle index so the order is fully defined.
-    std::nth_element(prims_.begin() + begin, prims_.begin() + mid, prims_.begin() + end, [&](uint32_t a, uint32_t b) {
-      const float ca = centroids_[a][axis], cb = centroids_[b][axis];
-      return ca < cb || (ca == cb && a < b);
+    std::nth_element(refs + begin, refs + mid, refs + end, [&](const PrimRef& a, const PrimRef& b) {
+      const float ca = a.center(axis), cb = b.center(axis);
+      return ca < cb || (ca == cb && a.id() < b.id());
     });
     return mid;
   }
@@ -326,24 +373,32 @@ class BvhBuilder {
   // Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
   // initialised, which matters because most nodes are small.
   // Four lanes (the fourth unused) so each min/max below compiles to one SSE instruction.
-  struct alignas(16) RawBin {
-    float lo[4], hi[4];
+  struct RawBin {
+    __m128 lo, hi;
     uint32_t count;
     void reset() {
-      for (int k = 0; k < 4; ++k) { lo[k] = kInfinity; hi[k] = -kInfinity; }
+      lo = _mm_set1_ps(kInfinity);
+      hi = _mm_set1_ps(-kInfinity);
       count = 0;
     }
-    void add(const Box4& b) {
-      for (int k = 0; k < 4; ++k) lo[k] = b.lo[k] < lo[k] ? b.lo[k] : lo[k];
-      for (int k = 0; k < 4; ++k) hi[k] = b.hi[k] > hi[k] ? b.hi[k] : hi[k];
+    void add(const PrimRef& r) {
+      lo = _mm_min_ps(lo, r.lo);
+      hi = _mm_max_ps(hi, r.hi);
       ++count;
     }
     void add(const RawBin& o) {
-      for (int k = 0; k < 4; ++k) lo[k] = o.lo[k] < lo[k] ? o.lo[k] : lo[k];
-      for (int k = 0; k < 4; ++k) hi[k] = o.hi[k] > hi[k] ? o.hi[k] : hi[k];
+      lo = _mm_min_ps(lo, o.lo);
+      hi = _mm_max_ps(hi, o.hi);
       count += o.count;
     }
-    Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+    // Aabb::half_area() of a non-empty bin, summed in the same order, without leaving SSE.
+    float half_area() const {
+      const __m128 e = _mm_and_ps(_mm_sub_ps(hi, lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+      const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy, yz, zx, 0
+      alignas(16) float a[4];
+      _mm_store_ps(a, p);
+      return a[0] + a[1] + a[2];
+    }
   };
 
   struct BinSet {
@@ -358,34 +413,55 @@ class BvhBuilder {
   };
 
   // Maps a centroid coordinate to its bin: precomputed offset and scale, no division per primitive.
+  // The float clamp before truncation gives what clamping the truncated int would; both paths
+  // below compute the same bin for the same centroid, which the partition relies on.
   struct Binner {
-    float lo[3], scale[3];
-    int nb;
-    Binner(const Aabb& cbox, int bins) : nb(bins) {
+    alignas(16) float lo[4], scale[4];
+    float top;
+    Binner(const Aabb& cbox, int bins) : top(float(bins - 1)) {
       for (int a = 0; a < 3; ++a) {
         lo[a] = cbox.lo[a];
         const float extent = cbox.hi[a] - cbox.lo[a];
         scale[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
       }
+      lo[3] = scale[3] = 0.0f;
     }
     int operator()(float c, int axis) const {
-      return std::clamp(static_cast<int>((c - lo[axis]) * scale[axis]), 0, nb - 1);
+      return static_cast<int>(std::min(std::max((c - lo[axis]) * scale[axis], 0.0f), top));
+    }
+    // Bins of a centroid on all three axes at once (lane 3 is 0).
+    __m128i operator()(__m128 c) const {
+      const __m128 x = _mm_mul_ps(_mm_sub_ps(c, _mm_load_ps(lo)), _mm_load_ps(scale));
+      return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(top)));
     }
   };
 
-  SahChoice sah_split(const BuildNode& node, const Aabb& cbox, bool parallel) const {
+  SahChoice sah_split(const PrimRef* refs, const BuildNode& node, const Aabb& cbox, bool parallel) const {
     // Fewer bins than primitives buy nothing: small nodes use fewer.
-    const int nb = std::clamp(int(node.end - node.begin), 4, options_.bins);
+    const int nb = std::clamp(4 + int(node.end - node.begin) / 16, 4, options_.bins);
     const Binner binner(cbox, nb);
+    const auto add = [&](const PrimRef& r, BinSet& acc) {
+      alignas(16) int32_t bin[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin), binner(r.center()));
+      acc.bins[0][bin[0]].add(r);
+      acc.bins[1][bin[1]].add(r);
+      acc.bins[2][bin[2]].add(r);
+    };
     const auto fill = [&](uint32_t b, uint32_t e, BinSet& acc) {
-      for (uint32_t i = b; i < e; ++i) {
-        const uint32_t p = prims_[i];
-        const Vec3 c = centroids_[p];
-        const Box4& box = box4_[p];
-        acc.bins[0][binner(c.x, 0)].add(box);
-        acc.bins[1][binner(c.y, 1)].add(box);
-        acc.bins[2][binner(c.z, 2)].add(box);
+      if (e - b < 256) {
+        for (uint32_t i = b; i < e; ++i) add(refs[i], acc);
+        return;
       }
+      // Neighbouring primitives often land in the same bin; alternating between two bin sets
+      // breaks the store-to-load chain through that bin. min/max and counts merge exactly.
+      BinSet odd(acc.nb);
+      uint32_t i = b;
+      for (; i + 1 < e; i += 2) {
+        add(refs[i], acc);
+        add(refs[i + 1], odd);
+      }
+      if (i < e) add(refs[i], acc);
+      acc.join(odd);
     };
     // Sequentially the bins are filled in place: a BinSet is kilobytes, and copying it per node
     // used to cost more than the binning itself.
@@ -408,14 +484,14 @@ class BvhBuilder {
       acc.reset();
       for (int s = nb - 1; s > 0; --s) {
         acc.add(bins.bins[a][s]);
-        right_cost[s] = acc.count ? acc.box().half_area() * float(acc.count) : kInfinity;
+        right_cost[s] = acc.count ? acc.half_area() * float(acc.count) : kInfinity;
       }
       acc.reset();
       for (int s = 1; s < nb; ++s) {
         acc.add(bins.bins[a][s - 1]);
         if (acc.count == 0) continue;
         const float cost = options_.traversal_cost +
-                           options_.intersection_cost * (acc.box().half_area() * float(acc.count) + right_cost[s]) * inv_area;
+                           options_.intersection_cost * (acc.half_area() * float(acc.count) + right_cost[s]) * inv_area;
         if (cost < best.cost) best = {a, s, cost, nb, acc.count};
       }
     }
@@ -424,25 +500,25 @@ class BvhBuilder {
     return best;
   }
 
-  // Stable partition of prims_[begin, end) by `pred`, whose true count the binning already gave
+  // Stable partition of src[begin, end) into dst[begin, end) by `pred`, whose true count the binning already gave
   // (`mid` = begin + that count), gathering each side's box and centroid bounds on the way so
   // the children need no bounds pass of their own. The parallel path computes the same
   // permutation and bounds as the sequential one.
   template <class Pred>
-  uint32_t partition(uint32_t begin, uint32_t end, uint32_t mid, bool parallel, Bounds4& lb, Bounds4& rb, const Pred& pred) {
+  uint32_t partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, Bounds4& lb,
+                     Bounds4& rb, const Pred& pred) {
     if (!parallel) {
       uint32_t l = begin, r = mid;
       for (uint32_t i = begin; i < end; ++i) {
-        const uint32_t p = prims_[i];
+        const PrimRef& p = src[i];
         if (pred(p)) {
-          scratch_[l++] = p;
-          lb.add(box4_[p]);
+          dst[l++] = p;
+          lb.add(p);
         } else {
-          scratch_[r++] = p;
-          rb.add(box4_[p]);
+          dst[r++] = p;
+          rb.add(p);
         }
       }
-      std::copy(scratch_.begin() + begin, scratch_.begin() + end, prims_.begin() + begin);
       return mid;
     }
     const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
@@ -450,7 +526,7 @@ class BvhBuilder {
     tbb::parallel_for(0u, blocks, [&](uint32_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       uint32_t c = 0;
-      for (uint32_t i = b; i < e; ++i) c += pred(prims_[i]) ? 1 : 0;
+      for (uint32_t i = b; i < e; ++i) c += pred(src[i]) ? 1 : 0;
       left_counts[k + 1] = c;
       publish();
     });
@@ -462,13 +538,13 @@ class BvhBuilder {
       uint32_t l = begin + left_counts[k];
       uint32_t r = mid + (b - begin) - left_counts[k];  // rights before this block
       for (uint32_t i = b; i < e; ++i) {
-        const uint32_t p = prims_[i];
+        const PrimRef& p = src[i];
         if (pred(p)) {
-          scratch_[l++] = p;
-          block_l[k].add(box4_[p]);
+          dst[l++] = p;
+          block_l[k].add(p);
         } else {
-          scratch_[r++] = p;
-          block_r[k].add(box4_[p]);
+          dst[r++] = p;
+          block_r[k].add(p);
         }
       }
       publish();
@@ -478,19 +554,18 @@ class BvhBuilder {
       lb.join(block_l[k]);
       rb.join(block_r[k]);
     }
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(begin, end, kPartitionBlock), [&](const tbb::blocked_range<uint32_t>& r) {
-      std::copy(scratch_.begin() + r.begin(), scratch_.begin() + r.end(), prims_.begin() + r.begin());
-      publish();
-    });
-    publish();
     return mid;
   }
 
   BvhBuildOptions options_;
-  std::vector<uint32_t> prims_, scratch_;
-  std::vector<Box4> box4_;
-  std::vector<Vec3> centroids_;
-  std::vector<BuildNode> nodes_;
+  struct FreeNodes {
+    void operator()(BuildNode* p) const { std::free(p); }
+  };
+  // Two buffers of count_ primitives: a partition reads a node's range from one and writes the
+  // children's ranges into the other (no copy back); BuildNode::buffer says which holds a node.
+  std::unique_ptr<PrimRef[]> buffers_[2];
+  uint32_t count_ = 0;
+  std::unique_ptr<BuildNode[], FreeNodes> nodes_;
   std::atomic<uint32_t> node_count_{0};
   mutable std::atomic<uint64_t> sync_{0};
 };
@@ -498,12 +573,32 @@ class BvhBuilder {
 }  // namespace
 
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), options_(options) {
-  BvhBuilder builder(scene, options);
-  builder.build();
-  builder.flatten(nodes_);
-  ids_ = builder.prims();
-  tris_.reserve(ids_.size());
-  for (uint32_t id : ids_) tris_.push_back(scene.triangles[id]);
+  const auto construct = [&] {
+    BvhBuilder builder(scene, options);
+    builder.build();
+    builder.flatten(nodes_, ids_);
+    tris_.resize(ids_.size());
+    const auto copy = [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];
+    };
+    if (options.mode == BuildMode::Tasks && ids_.size() >= kParallelSplit) {
+      std::atomic<uint32_t> published{0};  // happens-before edges TSan can see (see publish())
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, ids_.size(), kPartitionBlock), [&](const auto& r) {
+        copy(r.begin(), r.end());
+        published.fetch_add(1, std::memory_order_acq_rel);
+      });
+      published.fetch_add(1, std::memory_order_acq_rel);
+    } else {
+      copy(0, ids_.size());
+    }
+  };
+  if (options.mode == BuildMode::Tasks) {
+    // Every parallel piece of the tasks build, setup included, runs on this many threads.
+    tbb::task_arena arena(resolve_thread_count(options.threads));
+    arena.execute(construct);
+  } else {
+    construct();
+  }
 }
 
 }  // namespace tracer
