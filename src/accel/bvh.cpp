@@ -24,6 +24,8 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
     } else {
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];
+      prefetch_children(a);
+      prefetch_children(b);
       float ta = box.enter(a.lo, a.hi, ray.tnear, hit.t);
       float tb = box.enter(b.lo, b.hi, ray.tnear, hit.t);
       uint32_t near = node.index, far = node.index + 1;
@@ -71,6 +73,8 @@ bool Bvh::occluded(const Ray& ray) const {
       // box is the likelier blocker.
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];
+      prefetch_children(a);
+      prefetch_children(b);
       const float ta = box.enter(a.lo, a.hi, ray.tnear, ray.tfar);
       const float tb = box.enter(b.lo, b.hi, ray.tnear, ray.tfar);
       if (ta != kInfinity || tb != kInfinity) {

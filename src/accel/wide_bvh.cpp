@@ -146,27 +146,47 @@ HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, cons
 }
 
 struct StackEntry {
-  uint32_t child, count;
-  float t;
+  uint32_t child, count;  // count > 0: a leaf pack
+  float t;                // entry distance, for culling once a closer hit is known
 };
 
-// Sorts the hit children by entry distance and pushes them farthest first, so the nearest is
-// popped next. At most eight entries: insertion sort.
-HWY_INLINE void PushSorted(const WideNode& n, uint32_t bits, const float* t, StackEntry* stack, int& sp) {
+// Chooses the next child to visit among the hit children `bits` of `n` and pushes the others,
+// farthest first. One or two hits (by far the common cases) take no sort; more are sorted by an
+// insertion sort of at most eight entries. Returns false when no child was hit.
+HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackEntry* stack, int& sp, StackEntry& next) {
+  if (bits == 0) return false;
+  const int i = __builtin_ctz(bits);
+  bits &= bits - 1;
+  if (bits == 0) {
+    next = {n.child[i], n.count[i], t[i]};
+    return true;
+  }
+  const int j = __builtin_ctz(bits);
+  bits &= bits - 1;
+  if (bits == 0) {
+    const bool i_first = t[i] <= t[j];
+    const int near = i_first ? i : j, far = i_first ? j : i;
+    stack[sp++] = {n.child[far], n.count[far], t[far]};
+    next = {n.child[near], n.count[near], t[near]};
+    return true;
+  }
   StackEntry hits[kWideWidth];
   int k = 0;
+  bits |= (1u << i) | (1u << j);
   while (bits) {
-    const int i = __builtin_ctz(bits);
+    const int c = __builtin_ctz(bits);
     bits &= bits - 1;
-    StackEntry e{n.child[i], n.count[i], t[i]};
-    int j = k++;
-    while (j > 0 && hits[j - 1].t < e.t) {  // descending: farthest first
-      hits[j] = hits[j - 1];
-      --j;
+    StackEntry e{n.child[c], n.count[c], t[c]};
+    int m = k++;
+    while (m > 0 && hits[m - 1].t < e.t) {  // descending: farthest first
+      hits[m] = hits[m - 1];
+      --m;
     }
-    hits[j] = e;
+    hits[m] = e;
   }
-  for (int i = 0; i < k; ++i) stack[sp++] = hits[i];
+  for (int c = 0; c < k - 1; ++c) stack[sp++] = hits[c];
+  next = hits[k - 1];
+  return true;
 }
 
 bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
@@ -178,22 +198,24 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   const RayShear shear(ray);
   const Triangle* tris = bvh.triangles().data();
   const uint32_t* ids = bvh.triangle_ids().data();
+  const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
-  stack[sp++] = {0, 0, ray.tnear};
   HWY_ALIGN float t[kWideWidth];
-  while (sp > 0) {
-    const StackEntry e = stack[--sp];
-    if (!(e.t <= hit.t * RayBoxTest::kTieGuard)) continue;
-    if (e.count > 0) {
-      ClosestInPack(bvh.packs()[e.child], shear, tris, ids, ray.tnear, hit);
-      continue;
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode& n = nodes[cur.child];
+      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
+    } else {
+      ClosestInPack(packs[cur.child], shear, tris, ids, ray.tnear, hit);
     }
-    const WideNode& n = nodes[e.child];
-    const uint32_t bits = TestChildren(n, wr, ray.tnear, hit.t, t);
-    PushSorted(n, bits, t, stack, sp);
+    // Pop, skipping entries now beyond the closest hit (<=: ties still count).
+    do {
+      if (sp == 0) return finish_hit(bvh.scene(), hit);
+      cur = stack[--sp];
+    } while (!(cur.t <= hit.t * RayBoxTest::kTieGuard));
   }
-  return finish_hit(bvh.scene(), hit);
 }
 
 bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
@@ -202,21 +224,22 @@ bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
   const WideRay wr(ray);
   const RayShear shear(ray);
   const Triangle* tris = bvh.triangles().data();
+  const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
-  stack[sp++] = {0, 0, ray.tnear};
   HWY_ALIGN float t[kWideWidth];
-  while (sp > 0) {
-    const StackEntry e = stack[--sp];
-    if (e.count > 0) {
-      HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
-      if (IntersectPack(bvh.packs()[e.child], shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) return true;
-      continue;
+  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode& n = nodes[cur.child];
+      if (Descend(n, TestChildren(n, wr, ray.tnear, ray.tfar, t), t, stack, sp, cur)) continue;
+    } else if (IntersectPack(packs[cur.child], shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) {
+      return true;
     }
-    const WideNode& n = nodes[e.child];
-    PushSorted(n, TestChildren(n, wr, ray.tnear, ray.tfar, t), t, stack, sp);
+    if (sp == 0) return false;
+    cur = stack[--sp];
   }
-  return false;
 }
 
 // Brute force over packs: closest hit, ties to the lower scene index as everywhere.
@@ -311,20 +334,30 @@ namespace {
 class Collapser {
  public:
   Collapser(const Bvh& bin, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
-      : bin_(bin), out_(out), packs_(packs) {}
+      : bin_(bin), out_(out), packs_(packs), first_(bin.nodes().size()), count_(bin.nodes().size()) {
+    // Each binary subtree's triangles are one contiguous run (the builder lays leaves out in
+    // depth-first order); record it, children before parents (children have larger indices).
+    const auto& nodes = bin.nodes();
+    for (size_t i = nodes.size(); i-- > 0;) {
+      if (i == 1) continue;  // padding
+      const BvhNode& n = nodes[i];
+      first_[i] = n.leaf() ? n.index : first_[n.index];
+      count_[i] = n.leaf() ? n.count : count_[n.index] + count_[n.index + 1];
+    }
+  }
 
   uint32_t collapse(uint32_t root) {
     // Open the largest inner node until eight children (or only leaves) remain: keeps the
     // children's total surface area, and so the expected cost, as low as greedy can.
     std::vector<uint32_t> kids{root};
-    if (!bin_.nodes()[root].leaf()) kids = {bin_.nodes()[root].index, bin_.nodes()[root].index + 1};
+    if (!packable(root)) kids = {bin_.nodes()[root].index, bin_.nodes()[root].index + 1};
     while (kids.size() < size_t(kWideWidth)) {
       int best = -1;
       float best_area = -1.0f;
       for (size_t i = 0; i < kids.size(); ++i) {
         const BvhNode& n = bin_.nodes()[kids[i]];
         const float area = Aabb{n.lo, n.hi}.half_area();
-        if (!n.leaf() && area > best_area) {
+        if (!packable(kids[i]) && area > best_area) {
           best = int(i);
           best_area = area;
         }
@@ -347,9 +380,10 @@ class Collapser {
     }
     for (size_t i = 0; i < kids.size(); ++i) {
       const BvhNode& n = bin_.nodes()[kids[i]];
-      uint32_t child = 0, count = n.count;
-      if (n.leaf()) {
-        child = make_pack(n.index, n.count);
+      uint32_t child = 0, count = 0;
+      if (packable(kids[i])) {
+        count = count_[kids[i]];
+        child = make_pack(first_[kids[i]], count);
       } else {
         child = collapse(kids[i]);  // may reallocate out_: index, not reference
       }
@@ -367,6 +401,10 @@ class Collapser {
   }
 
  private:
+  // A subtree of at most one pack's worth of triangles becomes one leaf: testing eight lanes
+  // costs about what one more level of boxes would, and saves that level's loads.
+  bool packable(uint32_t node) const { return count_[node] <= uint32_t(kWideWidth); }
+
   uint32_t make_pack(uint32_t first, uint32_t count) {
     packs_.push_back(make_triangle_pack(bin_.triangles(), first, count));
     return static_cast<uint32_t>(packs_.size() - 1);
@@ -375,6 +413,7 @@ class Collapser {
   const Bvh& bin_;
   std::vector<WideNode>& out_;
   std::vector<TrianglePack>& packs_;
+  std::vector<uint32_t> first_, count_;  // per binary node: its subtree's triangle run
 };
 
 }  // namespace
