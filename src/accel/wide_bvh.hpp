@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "accel/bvh.hpp"
+#include "math/ray_packet.hpp"
 
 namespace tracer {
 
@@ -39,6 +40,9 @@ class WideBvh {
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
+  // Closest hits of the packet's active lanes, traversed together; hits[k] is exactly what
+  // intersect(rays.ray(k), hits[k]) gives. Inactive lanes' hits are left untouched.
+  void intersect_packet(const RayPacket& rays, Hit* hits) const;
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const std::vector<TrianglePack>& packs() const { return packs_; }

@@ -36,6 +36,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
   app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")->capture_default_str();
   app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
+  app.add_flag("--packets", a.packets, "trace primary rays in 4x4-pixel packets (--accel bvh8); same image");
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
@@ -72,7 +73,8 @@ void validate(const RenderArgs& a) {
     if (length(parse_vec3("--up", a.up)) == 0.0f) throw UsageError("--up: must not be the zero vector");
   }
   for (const auto& l : a.scene.lights) parse_vec3("--light", l);
-  accel_options_for(a);
+  const AccelOptions accel = accel_options_for(a);
+  if (a.packets && accel.kind != AccelKind::Bvh8) throw UsageError("--packets: needs --accel bvh8 (the packet kernels run on the 8-wide BVH)");
   parse_sched(a.sched);
   if (!WideBvh::force_simd_target(lower(a.simd_target))) {
     throw UsageError("--simd-target: unknown target '" + a.simd_target + "' (auto, avx512, avx2, sse4)");
@@ -117,6 +119,7 @@ RenderSettings settings_for(const RenderArgs& a) {
   s.ambient = float(a.ambient);
   s.exposure = float(a.exposure);
   s.seed = a.seed;
+  s.packets = a.packets;
   return s;
 }
 

@@ -36,6 +36,7 @@ struct RenderArgs {
   int max_leaf = 4, bins = 16;
   std::string simd = "auto";
   std::string simd_target = "auto";
+  bool packets = false;
   std::string sched = "tbb";
   std::optional<int> threads;
   int tile = 16, block = 64;

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "math/ray.hpp"
+#include "math/ray_packet.hpp"
 #include "math/rng.hpp"
 #include "render/framebuffer.hpp"
 #include "scene/camera.hpp"
@@ -24,6 +25,7 @@ struct RenderSettings {
   float ambient = 0.25f;         // ambient light, times Kd and the unoccluded AO fraction
   float exposure = 1.5f;         // tone-mapping exposure
   uint32_t seed = 0;
+  bool packets = false;          // primary rays in 4x4-pixel packets (accelerators that have them)
 };
 
 struct RayCounts {
@@ -73,14 +75,16 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
   return dot(d, n) < 0.0f ? -d : d;
 }
 
+// Accelerators that trace a RayPacket at once (the 8-wide BVH).
+template <class A>
+concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) { a.intersect_packet(p, h); };
+
+// The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
 template <class Accel>
-Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, RayCounts& counts) {
+Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit, RayCounts& counts) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
-  const Ray primary = ctx.camera.primary_ray(x, y);
-  ++counts.primary;
-  Hit hit;
-  if (!accel.intersect(primary, hit)) return Vec3{0.0f};
+  if (!hit.valid()) return Vec3{0.0f};
 
   const Triangle& tri = scene.triangles[hit.tri];
   const Material& mat = scene.materials[scene.tri_material[hit.tri]];
@@ -134,8 +138,44 @@ Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, Ray
 }
 
 template <class Accel>
+Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, RayCounts& counts) {
+  const Ray primary = ctx.camera.primary_ray(x, y);
+  ++counts.primary;
+  Hit hit;
+  accel.intersect(primary, hit);
+  return shade_hit(accel, ctx, x, y, primary, hit, counts);
+}
+
+template <class Accel>
 RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile) {
   RayCounts counts;
+  if constexpr (PacketAccelerator<Accel>) {
+    if (ctx.settings.packets) {
+      // Primary rays 4x4 pixels at a time (fewer at the tile's right and bottom edges); each
+      // lane's hit is the one its ray gets alone, so the image does not change.
+      for (int by = tile.y0; by < tile.y1; by += kPacketEdge) {
+        for (int bx = tile.x0; bx < tile.x1; bx += kPacketEdge) {
+          RayPacket packet;
+          Ray rays[kPacketSize];
+          for (int k = 0; k < kPacketSize; ++k) {
+            const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
+            if (x >= tile.x1 || y >= tile.y1) continue;
+            rays[k] = ctx.camera.primary_ray(x, y);
+            packet.set(k, rays[k]);
+          }
+          Hit hits[kPacketSize];
+          accel.intersect_packet(packet, hits);
+          for (uint32_t bits = packet.active; bits; bits &= bits - 1) {
+            const int k = __builtin_ctz(bits);
+            const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
+            ++counts.primary;
+            ctx.framebuffer->at(x, y) = shade_hit(accel, ctx, x, y, rays[k], hits[k], counts);
+          }
+        }
+      }
+      return counts;
+    }
+  }
   for (int y = tile.y0; y < tile.y1; ++y) {
     for (int x = tile.x0; x < tile.x1; ++x) ctx.framebuffer->at(x, y) = shade_pixel(accel, ctx, x, y, counts);
   }

@@ -1,0 +1,286 @@
+// Packet traversal of the 8-wide BVH: up to 16 coherent rays go down the tree together, one SIMD
+// lane per ray (one AVX-512 register, two AVX2 or four SSE4 ones). Each node's children are
+// loaded once per packet instead of once per ray, and a per-packet lane mask follows which rays
+// are still inside each subtree (per-ray box culling against each ray's own closest hit).
+//
+// Every lane computes exactly the scalar code's arithmetic (RayBoxTest, the watertight test of
+// triangle_test.hpp, closer()), so each ray gets the hit it gets alone, bit for bit. Packets whose
+// rays do not share the shear axes of that test (rare for primary rays) are traced ray by ray.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/wide_bvh_packets.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include <cmath>
+
+#include "accel/wide_bvh.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Per-lane constants and running results of one packet, as SoA arrays.
+struct PacketState {
+  HWY_ALIGN float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
+  HWY_ALIGN float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];    // reciprocal direction
+  HWY_ALIGN int32_t nx[kPacketSize], ny[kPacketSize], nz[kPacketSize];  // -1 where that reciprocal is negative
+  HWY_ALIGN float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];    // shear constants (RayShear)
+  HWY_ALIGN float tnear[kPacketSize];
+  HWY_ALIGN float t[kPacketSize], u[kPacketSize], v[kPacketSize];  // closest hit so far (t = tfar if none)
+  HWY_ALIGN int32_t tri[kPacketSize];  // its scene index with the sign bit flipped: signed order = unsigned order
+  const float* okx;                    // the origin component along the shared shear axes
+  const float* oky;
+  const float* okz;
+  int kx, ky, kz;
+  const RayPacket* rays;
+};
+
+constexpr int32_t kFlip = INT32_MIN;
+
+// Lane bits of `m` for the lanes [first, first + Lanes(d)).
+template <class D>
+HWY_INLINE uint32_t Bits(D d, hn::Mask<D> m) {
+  uint8_t bytes[8] = {0};
+  hn::StoreMaskBits(d, m, bytes);
+  return uint32_t(bytes[0]) | uint32_t(bytes[1]) << 8;
+}
+
+template <class D>
+HWY_INLINE hn::Mask<D> LaneMask(D d, uint32_t bits) {
+  const uint8_t bytes[8] = {uint8_t(bits), uint8_t(bits >> 8), 0, 0, 0, 0, 0, 0};
+  return hn::LoadMaskBits(d, bytes);
+}
+
+// Tests child `c` of `n` against the lanes in `mask`: returns the lanes that enter it before
+// their closest hit, and the entry distance of the first of them (the visiting order: in a
+// coherent packet one ray's order is the packet's, and it costs no reduction across lanes).
+HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState& st, uint32_t mask, float& entry) {
+  constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+  const hn::ScalableTag<float> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const size_t N = hn::Lanes(d);
+  const auto lo_x = hn::Set(d, n.lo_x[c]), lo_y = hn::Set(d, n.lo_y[c]), lo_z = hn::Set(d, n.lo_z[c]);
+  const auto hi_x = hn::Set(d, n.hi_x[c]), hi_y = hn::Set(d, n.hi_y[c]), hi_z = hn::Set(d, n.hi_z[c]);
+  const auto guard = hn::Set(d, kGuard), tie = hn::Set(d, RayBoxTest::kTieGuard);
+  HWY_ALIGN float t0s[kPacketSize];
+  uint32_t hits = 0;
+  for (size_t i = 0; i < size_t(kPacketSize); i += N) {
+    const uint32_t chunk = (mask >> i) & ((N >= 32 ? 0u : (1u << N)) - 1u);
+    if (chunk == 0) continue;
+    const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nx + i), hn::Zero(di)));
+    const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
+    const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nz + i), hn::Zero(di)));
+    const auto ox = hn::Load(d, st.ox + i), oy = hn::Load(d, st.oy + i), oz = hn::Load(d, st.oz + i);
+    const auto ix = hn::Load(d, st.ix + i), iy = hn::Load(d, st.iy + i), iz = hn::Load(d, st.iz + i);
+    auto t0 = hn::Load(d, st.tnear + i);
+    auto t1 = hn::Mul(hn::Load(d, st.t + i), tie);
+    const auto a = hn::Mul(hn::Sub(hn::IfThenElse(negx, hi_x, lo_x), ox), ix);
+    const auto b = hn::Mul(hn::Sub(hn::IfThenElse(negy, hi_y, lo_y), oy), iy);
+    const auto e = hn::Mul(hn::Sub(hn::IfThenElse(negz, hi_z, lo_z), oz), iz);
+    t0 = hn::IfThenElse(hn::Gt(a, t0), a, t0);  // NaN compares false: no cull, as in RayBoxTest
+    t0 = hn::IfThenElse(hn::Gt(b, t0), b, t0);
+    t0 = hn::IfThenElse(hn::Gt(e, t0), e, t0);
+    const auto f = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negx, lo_x, hi_x), ox), ix), guard);
+    const auto g = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negy, lo_y, hi_y), oy), iy), guard);
+    const auto h = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negz, lo_z, hi_z), oz), iz), guard);
+    t1 = hn::IfThenElse(hn::Lt(f, t1), f, t1);
+    t1 = hn::IfThenElse(hn::Lt(g, t1), g, t1);
+    t1 = hn::IfThenElse(hn::Lt(h, t1), h, t1);
+    const auto hit = hn::And(hn::Le(t0, t1), LaneMask(d, chunk));
+    if (hn::AllFalse(d, hit)) continue;
+    hits |= Bits(d, hit) << i;
+    hn::Store(t0, d, t0s + i);
+  }
+  entry = hits ? t0s[__builtin_ctz(hits)] : kInfinity;
+  return hits;
+}
+
+// Triangle `k` of `pack` against the lanes in `mask`, updating each lane's closest hit exactly
+// as intersect_range() does for one ray.
+HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, const uint32_t* ids, PacketState& st,
+                                        uint32_t mask) {
+  const hn::ScalableTag<float> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const size_t N = hn::Lanes(d);
+  const uint32_t slot = p.slot[k];
+  const int32_t id = int32_t(ids[slot] ^ uint32_t(kFlip));
+  const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
+  const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
+  const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
+  const auto vid = hn::Set(di, id);
+  for (size_t i = 0; i < size_t(kPacketSize); i += N) {
+    const uint32_t chunk = (mask >> i) & ((N >= 32 ? 0u : (1u << N)) - 1u);
+    if (chunk == 0) continue;
+    const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
+    const auto sx = hn::Load(d, st.sx + i), sy = hn::Load(d, st.sy + i), sz = hn::Load(d, st.sz + i);
+    const auto az_ = hn::Sub(az0, okz), bz_ = hn::Sub(bz0, okz), cz_ = hn::Sub(cz0, okz);
+    const auto ax = hn::Sub(hn::Sub(ax0, okx), hn::Mul(sx, az_)), ay = hn::Sub(hn::Sub(ay0, oky), hn::Mul(sy, az_));
+    const auto bx = hn::Sub(hn::Sub(bx0, okx), hn::Mul(sx, bz_)), by = hn::Sub(hn::Sub(by0, oky), hn::Mul(sy, bz_));
+    const auto cx = hn::Sub(hn::Sub(cx0, okx), hn::Mul(sx, cz_)), cy = hn::Sub(hn::Sub(cy0, oky), hn::Mul(sy, cz_));
+    const auto u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+    const auto v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+    const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    const auto neg = hn::Or(hn::Or(hn::Lt(u, zero), hn::Lt(v, zero)), hn::Lt(w, zero));
+    const auto pos = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
+    const auto det = hn::Add(hn::Add(u, v), w);
+    const auto rcp = hn::Div(one, det);
+    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))), rcp);
+    const auto best_t = hn::Load(d, st.t + i);
+    const auto best_id = hn::Load(di, st.tri + i);
+    auto hit = hn::AndNot(hn::And(neg, pos), hn::Ne(det, zero));
+    hit = hn::And(hit, hn::And(hn::And(hn::Ge(t, hn::Load(d, st.tnear + i)), hn::Le(t, best_t)), hn::Lt(t, inf)));
+    // closer(): nearer t wins; equal t goes to the lower scene index.
+    hit = hn::And(hit, hn::Or(hn::Lt(t, best_t), hn::And(hn::Eq(t, best_t), hn::RebindMask(d, hn::Lt(vid, best_id)))));
+    hit = hn::And(hit, LaneMask(d, chunk));
+    // Lanes exactly on an edge in float are decided by the scalar test in double, as they would
+    // be for that ray alone; their vector result is dropped.
+    const auto on_edge = hn::Or(hn::Or(hn::Eq(u, zero), hn::Eq(v, zero)), hn::Eq(w, zero));
+    hit = hn::AndNot(on_edge, hit);
+    const auto keep = hn::Not(hit);
+    hn::Store(hn::IfThenElse(keep, best_t, t), d, st.t + i);
+    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.u + i), hn::Mul(v, rcp)), d, st.u + i);
+    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.v + i), hn::Mul(w, rcp)), d, st.v + i);
+    hn::Store(hn::IfThenElse(hn::RebindMask(di, keep), best_id, vid), di, st.tri + i);
+    for (uint32_t bits = Bits(d, on_edge) & chunk; bits; bits &= bits - 1) {
+      const size_t lane = i + size_t(__builtin_ctz(bits));
+      const RayShear shear(st.rays->ray(int(lane)));
+      const uint32_t best_tri = uint32_t(st.tri[lane]) ^ uint32_t(kFlip);
+      Hit h;
+      h.t = st.t[lane];
+      h.tri = best_tri;
+      TriangleHit th;
+      if (intersect_triangle(shear, tris[slot], st.tnear[lane], h.t, th) && closer(th.t, ids[slot], h)) {
+        st.t[lane] = th.t;
+        st.u[lane] = th.u;
+        st.v[lane] = th.v;
+        st.tri[lane] = id;
+      }
+    }
+  }
+}
+
+struct PacketEntry {
+  uint32_t child, count;  // count > 0: a leaf pack
+  uint32_t lanes;         // the rays that entered this child
+  float t;                // their smallest entry distance
+};
+
+void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
+  const uint32_t active = rays.active & ((1u << kPacketSize) - 1u);
+  for (uint32_t bits = active; bits; bits &= bits - 1) {
+    const int lane = __builtin_ctz(bits);
+    hits[lane] = Hit{};
+    hits[lane].t = rays.tfar[lane];
+  }
+  if (active == 0 || bvh.nodes().empty()) return;
+  PacketState st;
+  st.rays = &rays;
+  st.kx = st.ky = st.kz = -1;
+  bool shared_axes = true;
+  for (int lane = 0; lane < kPacketSize; ++lane) {
+    const bool on = (active >> lane) & 1u;
+    // Inactive lanes get harmless values; the masks keep them out of every result.
+    const Ray r = on ? rays.ray(lane) : rays.ray(__builtin_ctz(active));
+    const RayShear shear(r);
+    if (on) {
+      if (st.kx < 0) {
+        st.kx = shear.kx;
+        st.ky = shear.ky;
+        st.kz = shear.kz;
+      }
+      shared_axes &= shear.kx == st.kx && shear.ky == st.ky && shear.kz == st.kz;
+    }
+    st.ox[lane] = r.org.x;
+    st.oy[lane] = r.org.y;
+    st.oz[lane] = r.org.z;
+    const RayBoxTest box(r);
+    st.ix[lane] = box.inv.x;
+    st.iy[lane] = box.inv.y;
+    st.iz[lane] = box.inv.z;
+    st.nx[lane] = box.neg_x ? -1 : 0;
+    st.ny[lane] = box.neg_y ? -1 : 0;
+    st.nz[lane] = box.neg_z ? -1 : 0;
+    st.sx[lane] = shear.sx;
+    st.sy[lane] = shear.sy;
+    st.sz[lane] = shear.sz;
+    st.tnear[lane] = r.tnear;
+    st.t[lane] = r.tfar;
+    st.u[lane] = st.v[lane] = 0.0f;
+    st.tri[lane] = int32_t(kInvalidId ^ uint32_t(kFlip));
+  }
+  if (!shared_axes) {
+    for (uint32_t bits = active; bits; bits &= bits - 1) {
+      const int lane = __builtin_ctz(bits);
+      bvh.intersect(rays.ray(lane), hits[lane]);
+    }
+    return;
+  }
+  const float* org[3] = {st.ox, st.oy, st.oz};
+  st.okx = org[st.kx];
+  st.oky = org[st.ky];
+  st.okz = org[st.kz];
+
+  const WideNode* nodes = bvh.nodes().data();
+  const TrianglePack* packs = bvh.packs().data();
+  const Triangle* tris = bvh.triangles().data();
+  const uint32_t* ids = bvh.triangle_ids().data();
+  PacketEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  PacketEntry cur{0, 0, active, 0.0f};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode& n = nodes[cur.child];
+      PacketEntry hit[kWideWidth];
+      int k = 0;
+      for (int c = 0; c < kWideWidth; ++c) {
+        if (!(n.lo_x[c] <= n.hi_x[c])) continue;  // empty slot
+        float entry;
+        const uint32_t lanes = TestChildPacket(n, c, st, cur.lanes, entry);
+        if (lanes == 0) continue;
+        // Insertion sort, farthest first: the nearest ends up last and is visited next.
+        PacketEntry e{n.child[c], n.count[c], lanes, entry};
+        int m = k++;
+        while (m > 0 && hit[m - 1].t < e.t) {
+          hit[m] = hit[m - 1];
+          --m;
+        }
+        hit[m] = e;
+      }
+      if (k > 0) {
+        for (int c = 0; c < k - 1; ++c) stack[sp++] = hit[c];
+        cur = hit[k - 1];
+        continue;
+      }
+    } else {
+      const TrianglePack& p = packs[cur.child];
+      for (uint32_t k = 0; k < cur.count; ++k) IntersectTrianglePacket(p, int(k), tris, ids, st, cur.lanes);
+    }
+    if (sp == 0) break;
+    cur = stack[--sp];
+  }
+  for (uint32_t bits = active; bits; bits &= bits - 1) {
+    const int lane = __builtin_ctz(bits);
+    Hit& h = hits[lane];
+    h.tri = uint32_t(st.tri[lane]) ^ uint32_t(kFlip);
+    h.t = st.t[lane];
+    h.u = st.u[lane];
+    h.v = st.v[lane];
+    finish_hit(bvh.scene(), h);
+  }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer {
+
+HWY_EXPORT(IntersectPacketWide);
+
+void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits) const { HWY_DYNAMIC_DISPATCH(IntersectPacketWide)(*this, rays, hits); }
+
+}  // namespace tracer
+#endif  // HWY_ONCE
