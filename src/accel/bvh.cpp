@@ -24,8 +24,12 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
     } else {
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];
-      prefetch_children(a);
-      prefetch_children(b);
+      // Both children's next lines are requested now, so the loads of the near and the far path
+      // overlap (traversal of trees larger than L2 waits on dependent node loads). Branches, not
+      // selects, decide the order: coherent rays follow each other down the same paths, which
+      // the branch predictor learns.
+      __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris_[a.index]) : &nodes_[a.index]);
+      __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris_[b.index]) : &nodes_[b.index]);
       float ta = box.enter(a.lo, a.hi, ray.tnear, hit.t);
       float tb = box.enter(b.lo, b.hi, ray.tnear, hit.t);
       uint32_t near = node.index, far = node.index + 1;
@@ -69,18 +73,19 @@ bool Bvh::occluded(const Ray& ray) const {
         if (intersect_triangle(shear, tris_[i], ray.tnear, ray.tfar, th)) return true;
       }
     } else {
-      // Children are tested from the parent, nearer first: any hit ends the query, and the nearer
-      // box is the likelier blocker.
+      // Children are tested from the parent. Any hit ends the query, so no order is needed:
+      // the left child goes first, the right one is pushed when both are entered.
       const BvhNode& a = nodes_[node.index];
       const BvhNode& b = nodes_[node.index + 1];
-      prefetch_children(a);
-      prefetch_children(b);
-      const float ta = box.enter(a.lo, a.hi, ray.tnear, ray.tfar);
-      const float tb = box.enter(b.lo, b.hi, ray.tnear, ray.tfar);
-      if (ta != kInfinity || tb != kInfinity) {
-        const bool a_first = ta <= tb;
-        if (ta != kInfinity && tb != kInfinity) stack[sp++] = a_first ? node.index + 1 : node.index;
-        current = a_first ? node.index : node.index + 1;
+      __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris_[a.index]) : &nodes_[a.index]);
+      __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris_[b.index]) : &nodes_[b.index]);
+      float a0, b0;
+      const bool ha = box.hit(a.lo, a.hi, ray.tnear, ray.tfar, a0);
+      const bool hb = box.hit(b.lo, b.hi, ray.tnear, ray.tfar, b0);
+      if (ha | hb) {
+        current = node.index + uint32_t(!ha);
+        stack[sp] = node.index + 1;
+        sp += int(ha & hb);
         continue;
       }
     }

@@ -81,17 +81,6 @@ class Bvh {
   std::string validate() const;
 
  private:
-  // Traversal is bound by the latency of dependent node loads once the tree outgrows L2. Both
-  // children's next lines (their child pair, or their triangles) are requested as soon as the
-  // children are read, so the loads of the near and the far path overlap.
-  void prefetch_children(const BvhNode& n) const {
-    if (n.leaf()) {
-      __builtin_prefetch(&tris_[n.index]);
-    } else {
-      __builtin_prefetch(&nodes_[n.index]);
-    }
-  }
-
   const Scene* scene_;
   BvhBuildOptions options_;
   BvhNodeArray nodes_;
@@ -118,6 +107,12 @@ struct RayBoxTest {
   }
   // Entry distance, or +inf on a miss. tnear and tfar must not be NaN.
   float enter(const Vec3& lo, const Vec3& hi, float tnear, float tfar) const {
+    float t0;
+    return hit(lo, hi, tnear, tfar, t0) ? t0 : kInfinity;
+  }
+  // Whether the ray enters the box within [tnear, tfar]; t0 receives the entry distance. No
+  // branch: traversal turns the two children's answers into its next step with plain arithmetic.
+  bool hit(const Vec3& lo, const Vec3& hi, float tnear, float tfar, float& t0_out) const {
     constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
     float t0 = tnear, t1 = tfar * kTieGuard;
     const auto slab = [&](float l, float h, float o, float i, bool neg) {
@@ -129,7 +124,8 @@ struct RayBoxTest {
     slab(lo.x, hi.x, org.x, inv.x, neg_x);
     slab(lo.y, hi.y, org.y, inv.y, neg_y);
     slab(lo.z, hi.z, org.z, inv.z, neg_z);
-    return t0 <= t1 ? t0 : kInfinity;
+    t0_out = t0;
+    return t0 <= t1;
   }
 };
 

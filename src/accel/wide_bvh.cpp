@@ -99,6 +99,9 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
     const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
     const auto neg = hn::Or(hn::Or(u < zero, v < zero), w < zero);
     const auto pos = hn::Or(hn::Or(u > zero, v > zero), w > zero);
+    const auto on_edge = hn::Or(hn::Or(u == zero, v == zero), w == zero);
+    // Most packs a ray reaches it misses entirely: then skip the division and the stores.
+    if (hn::AllTrue(d, hn::AndNot(on_edge, hn::And(neg, pos)))) continue;
     const auto det = hn::Add(hn::Add(u, v), w);
     const auto rcp = hn::Div(one, det);
     const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))), rcp);
@@ -109,7 +112,7 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
     hn::Store(hn::Mul(w, rcp), d, v_out + i);
     uint8_t hit_bits[8] = {0}, edge_bits[8] = {0};
     hn::StoreMaskBits(d, hit, hit_bits);
-    hn::StoreMaskBits(d, hn::Or(hn::Or(u == zero, v == zero), w == zero), edge_bits);
+    hn::StoreMaskBits(d, on_edge, edge_bits);
     uint32_t h = hit_bits[0], edge = edge_bits[0];
     while (edge) {  // exactly on an edge in float: let the scalar test decide in double
       const int k = __builtin_ctz(edge);
@@ -232,8 +235,18 @@ bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
   StackEntry cur{0, 0, ray.tnear};
   for (;;) {
     if (cur.count == 0) {
+      // Any hit ends the query, so the children need no order: push them as found.
       const WideNode& n = nodes[cur.child];
-      if (Descend(n, TestChildren(n, wr, ray.tnear, ray.tfar, t), t, stack, sp, cur)) continue;
+      uint32_t bits = TestChildren(n, wr, ray.tnear, ray.tfar, t);
+      if (bits) {
+        int c = __builtin_ctz(bits);
+        for (bits &= bits - 1; bits; bits &= bits - 1) {
+          const int o = __builtin_ctz(bits);
+          stack[sp++] = {n.child[o], n.count[o], 0.0f};
+        }
+        cur = {n.child[c], n.count[c], 0.0f};
+        continue;
+      }
     } else if (IntersectPack(packs[cur.child], shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) {
       return true;
     }
