@@ -311,7 +311,7 @@ class BvhBuilder {
       node.bounds_known = true;
     }
     uint32_t mid;
-    Bounds4 child_bounds[2];
+    Aabb child_box[2], child_cbox[2];
     bool children_known = false;
     if (options_.split == BvhSplit::Median) {
       if (count <= 2) return false;  // the study's leaves of one or two triangles
@@ -332,13 +332,15 @@ class BvhBuilder {
           const float leaf_cost = options_.intersection_cost * float(count);
           if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
           const Binner binner(node.cbox, sah.bins);
-          Bounds4 lb, rb;
           child_buffer = uint8_t(1 - node.buffer);
-          mid = partition(refs, buffers_[child_buffer].get(), begin, end, begin + sah.left_count, parallel, lb, rb, [&](const PrimRef& prim) {
+          SideCentroids centroids;
+          mid = partition(refs, buffers_[child_buffer].get(), begin, end, begin + sah.left_count, parallel, centroids, [&](const PrimRef& prim) {
             return binner(prim.center(sah.axis), sah.axis) < sah.split_bin;
           });
-          child_bounds[0] = lb;
-          child_bounds[1] = rb;
+          child_box[0] = sah.left_box;
+          child_box[1] = sah.right_box;
+          child_cbox[0] = Bounds4::to_aabb(centroids.llo, centroids.lhi);
+          child_cbox[1] = Bounds4::to_aabb(centroids.rlo, centroids.rhi);
           children_known = true;
         }
       }
@@ -348,8 +350,8 @@ class BvhBuilder {
     nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
     if (children_known) {
       for (int c = 0; c < 2; ++c) {
-        nodes_[left + c].box = child_bounds[c].box();
-        nodes_[left + c].cbox = child_bounds[c].centroids();
+        nodes_[left + c].box = child_box[c];
+        nodes_[left + c].cbox = child_cbox[c];
         nodes_[left + c].bounds_known = true;
       }
     }
@@ -368,7 +370,14 @@ class BvhBuilder {
     return mid;
   }
 
-  struct SahChoice { int axis = -1; int split_bin = 0; float cost = 0.0f; int bins = 0; uint32_t left_count = 0; };
+  struct SahChoice {
+    int axis = -1;
+    int split_bin = 0;
+    float cost = 0.0f;
+    int bins = 0;
+    uint32_t left_count = 0;
+    Aabb left_box, right_box;  // the children's boxes: unions of their bins' boxes, exactly
+  };
 
   // Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
   // initialised, which matters because most nodes are small.
@@ -495,30 +504,62 @@ class BvhBuilder {
         if (cost < best.cost) best = {a, s, cost, nb, acc.count};
       }
     }
-    if (!(best.cost < kInfinity)) best.axis = -1;
+    if (!(best.cost < kInfinity)) {
+      best.axis = -1;
+    } else {
+      RawBin l, r;
+      l.reset();
+      r.reset();
+      for (int b = 0; b < best.split_bin; ++b) l.add(bins.bins[best.axis][b]);
+      for (int b = best.split_bin; b < nb; ++b) r.add(bins.bins[best.axis][b]);
+      best.left_box = Bounds4::to_aabb(l.lo, l.hi);
+      best.right_box = Bounds4::to_aabb(r.lo, r.hi);
+    }
     best.bins = nb;
     return best;
   }
 
-  // Stable partition of src[begin, end) into dst[begin, end) by `pred`, whose true count the binning already gave
-  // (`mid` = begin + that count), gathering each side's box and centroid bounds on the way so
-  // the children need no bounds pass of their own. The parallel path computes the same
-  // permutation and bounds as the sequential one.
+  // Centroid bounds of the two sides of a partition, accumulated without a branch per primitive.
+  struct SideCentroids {
+    __m128 llo = _mm_set1_ps(kInfinity), lhi = _mm_set1_ps(-kInfinity);
+    __m128 rlo = _mm_set1_ps(kInfinity), rhi = _mm_set1_ps(-kInfinity);
+    void add(bool left, const PrimRef& p) {
+      const __m128 m = _mm_castsi128_ps(_mm_set1_epi32(-int32_t(left)));
+      const __m128 c = p.center();
+      const __m128 inf = _mm_set1_ps(kInfinity), ninf = _mm_set1_ps(-kInfinity);
+      llo = _mm_min_ps(llo, _mm_or_ps(_mm_and_ps(m, c), _mm_andnot_ps(m, inf)));
+      lhi = _mm_max_ps(lhi, _mm_or_ps(_mm_and_ps(m, c), _mm_andnot_ps(m, ninf)));
+      rlo = _mm_min_ps(rlo, _mm_or_ps(_mm_andnot_ps(m, c), _mm_and_ps(m, inf)));
+      rhi = _mm_max_ps(rhi, _mm_or_ps(_mm_andnot_ps(m, c), _mm_and_ps(m, ninf)));
+    }
+    void join(const SideCentroids& o) {
+      llo = _mm_min_ps(llo, o.llo);
+      lhi = _mm_max_ps(lhi, o.lhi);
+      rlo = _mm_min_ps(rlo, o.rlo);
+      rhi = _mm_max_ps(rhi, o.rhi);
+    }
+  };
+
+  // Stable partition of src[begin, end) into dst[begin, end) by `pred`, whose true count the
+  // binning already gave (`mid` = begin + that count), gathering each side's centroid bounds on
+  // the way (the boxes come from the bins) so the children need no bounds pass of their own.
+  // Each primitive is stored once at a selected index: the side decides no branch, which the
+  // CPU could not predict. The parallel path computes the same permutation and bounds.
   template <class Pred>
-  uint32_t partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, Bounds4& lb,
-                     Bounds4& rb, const Pred& pred) {
-    if (!parallel) {
-      uint32_t l = begin, r = mid;
-      for (uint32_t i = begin; i < end; ++i) {
+  uint32_t partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, SideCentroids& out,
+                     const Pred& pred) {
+    const auto run = [&](uint32_t b, uint32_t e, uint32_t l, uint32_t r, SideCentroids& acc) {
+      for (uint32_t i = b; i < e; ++i) {
         const PrimRef& p = src[i];
-        if (pred(p)) {
-          dst[l++] = p;
-          lb.add(p);
-        } else {
-          dst[r++] = p;
-          rb.add(p);
-        }
+        const bool left = pred(p);
+        dst[left ? l : r] = p;
+        l += uint32_t(left);
+        r += uint32_t(!left);
+        acc.add(left, p);
       }
+    };
+    if (!parallel) {
+      run(begin, end, begin, mid, out);
       return mid;
     }
     const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
@@ -532,28 +573,14 @@ class BvhBuilder {
     });
     publish();
     for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
-    std::vector<Bounds4> block_l(blocks), block_r(blocks);
+    std::vector<SideCentroids> block(blocks);
     tbb::parallel_for(0u, blocks, [&](uint32_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
-      uint32_t l = begin + left_counts[k];
-      uint32_t r = mid + (b - begin) - left_counts[k];  // rights before this block
-      for (uint32_t i = b; i < e; ++i) {
-        const PrimRef& p = src[i];
-        if (pred(p)) {
-          dst[l++] = p;
-          block_l[k].add(p);
-        } else {
-          dst[r++] = p;
-          block_r[k].add(p);
-        }
-      }
+      run(b, e, begin + left_counts[k], mid + (b - begin) - left_counts[k], block[k]);  // rights before this block
       publish();
     });
     publish();
-    for (uint32_t k = 0; k < blocks; ++k) {
-      lb.join(block_l[k]);
-      rb.join(block_r[k]);
-    }
+    for (uint32_t k = 0; k < blocks; ++k) out.join(block[k]);
     return mid;
   }
 
