@@ -72,6 +72,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --simd maybe", 2, "--simd: expected auto or off, got 'maybe'"},
       {"render --accel bvh8 --simd off", 2, "--simd off: bvh8 is the SIMD tree"},
       {"render --simd-target neon", 2, "--simd-target: unknown target 'neon'"},
+      {"render --packets", 2, "--packets: needs --accel bvh8"},
+      {"render --accel embree --packets", 2, "--packets: needs --accel bvh8"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
   };
   for (const CliCase& c : cases) {

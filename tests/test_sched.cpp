@@ -21,8 +21,9 @@ struct Rendered {
   RayCounts counts;
 };
 
-Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size) {
+Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size, bool packets = false) {
   RenderSettings s;
+  s.packets = packets;
   s.width = size;
   s.height = size * 3 / 4 + 1;  // not a multiple of any tile size
   s.ao_samples = 4;
@@ -84,6 +85,32 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
           EXPECT_EQ(r.counts.total(), reference.counts.total());
           if (kind == SchedKind::Async) break;  // rows: the tile size does not apply
         }
+      }
+    }
+  }
+}
+
+TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
+  // The 8-wide BVH, with and without primary-ray packets, against the scalar BVH's image; tile
+  // sizes not a multiple of the 4x4 packet leave partial packets at every tile's edge.
+  const int size = int(test::ray_budget(100'000) >= 100'000 ? 48 : 24);
+  for (const Scene& scene : scenes()) {
+    SCOPED_TRACE(scene.source);
+    SchedOptions seq;
+    seq.kind = SchedKind::Seq;
+    const Rendered reference = render_with(scene, build_accelerator(scene, AccelOptions{}), seq, size);
+    const Accelerator wide = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh8});
+    for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
+      for (const bool packets : {false, true}) {
+        SchedOptions so;
+        so.kind = kind;
+        so.threads = 2;
+        so.tile = 7;
+        so.block = 30;
+        SCOPED_TRACE(to_string(kind) + (packets ? " packets" : " single rays"));
+        const Rendered r = render_with(scene, wide, so, size, packets);
+        EXPECT_EQ(r.rgb, reference.rgb);
+        EXPECT_EQ(r.counts.total(), reference.counts.total());
       }
     }
   }
