@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates every figure behind docs/BENCHMARKS.md on this machine (about 15 minutes on 2 cores):
+# Regenerates every figure behind docs/BENCHMARKS.md on this machine (about 25 minutes on 2 cores):
 # the study's table, the scheduler scaling at 1 and 2 threads, the per-task overhead, our variants
 # with Embree on all scenes, and the Google Benchmark microbenchmarks. Outputs go to docs/bench/.
 # Run from the project root with ../shared/scenes beside it, on an otherwise idle machine.
@@ -28,6 +28,9 @@ mkdir -p "$O"
 $T bench --scenes cornell --variants study,sah,tbb+sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
   --max-seconds 30 --json "$O/study.json" --markdown "$O/study.md" --plot "$O/study.svg"
 
+# The study's ISPC column: brute force eight triangles per SIMD pass, one thread.
+$T bench --scenes cornell --variants seq,simd-brute --size 128x128 --ao 4 --runs 10 --best 3 --markdown "$O/simd-brute.md"
+
 # 2. Schedulers at 1 and 2 threads (SAH BVH), and the per-task overhead on a near-empty scene.
 for t in 1 2; do
   $T bench --scenes cornell,../shared/scenes/sponza/sponza.obj --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah \
@@ -36,14 +39,19 @@ done
 $T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah --size 2048x2048 --ao 0 \
   --runs 5 --best 3 --threads 2 --markdown "$O/overhead.md"
 
-# 3. Our best against Embree on every scene, at 1 and 2 threads.
+# 3. Our trees against Embree on every scene, at 1 and 2 threads; then the SIMD issue's workload
+#    (1024x1024, 16 AO rays) for the 8-wide BVH with and without primary-ray packets.
 for t in 1 2; do
-  $T bench --scenes cornell,large --variants bvh,sah,tbb+sah,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t \
+  $T bench --scenes cornell,large --variants bvh,sah,tbb+sah,bvh8,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t \
     --json "$O/embree-t$t.json" --markdown "$O/embree-t$t.md" --plot "$O/embree-t$t.svg"
+done
+for t in 1 2; do
+  $T bench --scenes cornell,large --variants bvh8,best,embree --size 1024x1024 --ao 16 --runs 3 --best 2 --threads $t \
+    --json "$O/simd-1024-t$t.json" --markdown "$O/simd-1024-t$t.md"
 done
 
 # 4. Microbenchmarks: build times per split/builder, Mrays/s per ray type, bytes per triangle.
 build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console \
-  --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
+  --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Primary1024/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/microbench.txt"
 echo "figures written to $O/"
