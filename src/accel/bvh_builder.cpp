@@ -62,11 +62,12 @@ struct alignas(32) PrimRef {
     const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
     return _mm_mul_ps(_mm_add_ps(_mm_and_ps(lo, xyz), hi), _mm_set1_ps(0.5f));
   }
-  float center(int axis) const {
-    alignas(16) float c[4];
-    _mm_store_ps(c, center());
-    return c[axis];
+  template <int Axis>
+  float center() const {
+    const __m128 c = center();
+    return _mm_cvtss_f32(_mm_shuffle_ps(c, c, _MM_SHUFFLE(Axis, Axis, Axis, Axis)));
   }
+  float center(int axis) const { return axis == 0 ? center<0>() : axis == 1 ? center<1>() : center<2>(); }
 };
 static_assert(sizeof(PrimRef) == 32);
 
@@ -361,10 +362,18 @@ class BvhBuilder {
   }
 
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis) {
+    switch (axis) {
+      case 0: return median_split<0>(refs, begin, end);
+      case 1: return median_split<1>(refs, begin, end);
+      default: return median_split<2>(refs, begin, end);
+    }
+  }
+  template <int Axis>
+  uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end) {
     const uint32_t mid = begin + (end - begin) / 2;
     // Ties broken by triangle index so the order is fully defined.
-    std::nth_element(refs + begin, refs + mid, refs + end, [&](const PrimRef& a, const PrimRef& b) {
-      const float ca = a.center(axis), cb = b.center(axis);
+    std::nth_element(refs + begin, refs + mid, refs + end, [](const PrimRef& a, const PrimRef& b) {
+      const float ca = a.center<Axis>(), cb = b.center<Axis>();
       return ca < cb || (ca == cb && a.id() < b.id());
     });
     return mid;
