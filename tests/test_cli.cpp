@@ -122,6 +122,14 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Image8 ppm = read_image(dir_ + "/a.ppm");
   EXPECT_EQ(ppm.rgb, png.rgb);  // same render, two containers
+  // The 8-wide BVH with primary-ray packets: the same image, every primary ray counted once.
+  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --accel bvh8 --packets --stats-json " + dir_ + "/p.json -o " + dir_ + "/p.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/p.png").rgb, png.rgb);
+  std::ifstream pjson(dir_ + "/p.json");
+  const std::string ptext((std::istreambuf_iterator<char>(pjson)), {});
+  EXPECT_NE(ptext.find("\"packets\": true"), std::string::npos) << ptext;
+  EXPECT_NE(ptext.find("\"primary\": 192"), std::string::npos) << ptext;
   r = test::run_tracer("info " + scene);
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.output.find("triangles   1"), std::string::npos) << r.output;

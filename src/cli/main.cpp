@@ -78,7 +78,8 @@ int cmd_render(const RenderArgs& args) {
   if (args.stats) {
     std::printf("scene        %s (%zu triangles)\n", scene.source.c_str(), scene.size());
     std::printf("image        %dx%d, %d AO rays per hit -> %s\n", settings.width, settings.height, settings.ao_samples, args.output.c_str());
-    std::printf("accelerator  %s, %.1f bytes/triangle\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()));
+    std::printf("accelerator  %s, %.1f bytes/triangle%s\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()),
+                settings.packets ? ", primary rays in 4x4 packets" : "");
     if (const auto* bvh = std::get_if<Bvh>(accel.impl.get())) {
       const BvhStats st = bvh->stats();
       std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st.nodes, st.leaves,
@@ -97,7 +98,7 @@ int cmd_render(const RenderArgs& args) {
     j << "{\n  \"scene\": \"" << scene.source << "\",\n  \"triangles\": " << scene.size()
       << ",\n  \"width\": " << settings.width << ",\n  \"height\": " << settings.height
       << ",\n  \"ao_samples\": " << settings.ao_samples << ",\n  \"accel\": \"" << accel.name
-      << "\",\n  \"sched\": \"" << to_string(sched.kind) << "\",\n  \"threads\": "
+      << "\",\n  \"packets\": " << (settings.packets ? "true" : "false") << ",\n  \"sched\": \"" << to_string(sched.kind) << "\",\n  \"threads\": "
       << (sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads))
       << ",\n  \"load_ms\": " << load_ms << ",\n  \"build_ms\": " << accel.build_ms << ",\n  \"render_ms\": " << render_ms
       << ",\n  \"rays\": {\"primary\": " << rays.primary << ", \"shadow\": " << rays.shadow << ", \"ao\": " << rays.ao
