@@ -39,8 +39,8 @@ size_t disagreements(const Scene& scene, const std::vector<Ray>& rays) {
   return bad;
 }
 
-TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
-  TargetGuard guard;
+// The built-in box with spheres, and from ../shared/scenes two Cornell boxes, Sponza and the Bunny.
+std::vector<Scene> agreement_scenes() {
   std::vector<Scene> scenes;
   scenes.push_back(make_cornell_box(5000));
   if (test::have_shared_scenes()) {
@@ -48,6 +48,12 @@ TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
       scenes.push_back(load_obj(test::scene_path(p), [](const std::string&) {}));
     }
   }
+  return scenes;
+}
+
+TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
+  TargetGuard guard;
+  const std::vector<Scene> scenes = agreement_scenes();
   for (const std::string& target : targets()) {
     ASSERT_TRUE(WideBvh::force_simd_target(target));
     SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
@@ -212,13 +218,7 @@ std::vector<Ray> primary_rays_in_packet_order(const Scene& scene, int width, int
 
 TEST(RayPackets, SameHitsAsSingleRaysOnEveryTarget) {
   TargetGuard guard;
-  std::vector<Scene> scenes;
-  scenes.push_back(make_cornell_box(5000));
-  if (test::have_shared_scenes()) {
-    for (const char* p : {"cornell-box/CornellBox-Original.obj", "cornell-box/CornellBox-Water.obj", "sponza/sponza.obj", "bunny/bunny.obj"}) {
-      scenes.push_back(load_obj(test::scene_path(p), [](const std::string&) {}));
-    }
-  }
+  const std::vector<Scene> scenes = agreement_scenes();
   for (const std::string& target : targets()) {
     ASSERT_TRUE(WideBvh::force_simd_target(target));
     SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
