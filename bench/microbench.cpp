@@ -94,7 +94,7 @@ void BM_BoxTest(benchmark::State& state) {
   const auto& nodes = c.bvh->nodes();
   float acc = 0;
   for (auto _ : state) {
-    for (const BvhNode& n : nodes) acc += box.enter(n.lo, n.hi, 0.0f, kInfinity) == kInfinity ? 0.0f : 1.0f;
+    for (const BvhNode& n : nodes) acc += box.enter(n, 0.0f, kInfinity) == kInfinity ? 0.0f : 1.0f;
   }
   benchmark::DoNotOptimize(acc);
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(nodes.size()));

@@ -11,7 +11,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
   if (nodes_.empty()) return false;
   const RayShear shear(ray);
   const RayBoxTest box(ray);
-  if (box.enter(nodes_[0].lo, nodes_[0].hi, ray.tnear, hit.t) == kInfinity) return false;
+  if (box.enter(nodes_[0], ray.tnear, hit.t) == kInfinity) return false;
 
   struct Entry { uint32_t node; float t; };
   Entry stack[kMaxDepth + 2];
@@ -30,8 +30,8 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
       // the branch predictor learns.
       __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris_[a.index]) : &nodes_[a.index]);
       __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris_[b.index]) : &nodes_[b.index]);
-      float ta = box.enter(a.lo, a.hi, ray.tnear, hit.t);
-      float tb = box.enter(b.lo, b.hi, ray.tnear, hit.t);
+      float ta = box.enter(a, ray.tnear, hit.t);
+      float tb = box.enter(b, ray.tnear, hit.t);
       uint32_t near = node.index, far = node.index + 1;
       if (tb < ta) {
         std::swap(ta, tb);
@@ -61,7 +61,7 @@ bool Bvh::occluded(const Ray& ray) const {
   if (nodes_.empty()) return false;
   const RayShear shear(ray);
   const RayBoxTest box(ray);
-  if (box.enter(nodes_[0].lo, nodes_[0].hi, ray.tnear, ray.tfar) == kInfinity) return false;
+  if (box.enter(nodes_[0], ray.tnear, ray.tfar) == kInfinity) return false;
   uint32_t stack[kMaxDepth + 2];
   int sp = 0;
   uint32_t current = 0;
@@ -80,8 +80,8 @@ bool Bvh::occluded(const Ray& ray) const {
       __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris_[a.index]) : &nodes_[a.index]);
       __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris_[b.index]) : &nodes_[b.index]);
       float a0, b0;
-      const bool ha = box.hit(a.lo, a.hi, ray.tnear, ray.tfar, a0);
-      const bool hb = box.hit(b.lo, b.hi, ray.tnear, ray.tfar, b0);
+      const bool ha = box.hit(a, ray.tnear, ray.tfar, a0);
+      const bool hb = box.hit(b, ray.tnear, ray.tfar, b0);
       if (ha | hb) {
         current = node.index + uint32_t(!ha);
         stack[sp] = node.index + 1;

@@ -2,7 +2,9 @@
 // contiguous run. Traversal is iterative, nearest child first, with a conservative slab test.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <new>
 #include <string>
 #include <vector>
@@ -90,40 +92,50 @@ class Bvh {
 
 // Slab test with a per-ray reciprocal direction (Williams et al. 2005, as pbrt does it): a zero
 // direction component gives an infinite reciprocal, and an origin exactly on that slab's plane
-// gives 0*inf = NaN, which the comparisons below drop, so such a slab never culls. The far
-// distance is scaled by 1 + 2*gamma(3) (Ize 2013) so rounding never culls a box the ray touches.
+// gives 0*inf = NaN, which the comparisons below drop, so such a slab never culls. Far distances
+// are scaled by 1 + 2*gamma(3) (Ize 2013) so rounding never culls a box the ray touches; the scale
+// is folded into a second reciprocal, which rounds once as the separate multiply did, so the
+// bound is the same and the far chain is one multiply shorter.
 struct RayBoxTest {
   // Boxes are also kept when entered up to ~16 ulps beyond tfar: a box's entry distance and a
   // triangle's t round differently, and a triangle hit at exactly the current closest t must
   // still be reached so ties resolve the same way as in brute force.
   static constexpr float kTieGuard = 1.0f + 0x1p-20f;
-  Vec3 org, inv;
-  bool neg_x, neg_y, neg_z;
-  explicit RayBoxTest(const Ray& r) : org(r.org) {
-    inv = {1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z};
-    neg_x = std::signbit(inv.x);
-    neg_y = std::signbit(inv.y);
-    neg_z = std::signbit(inv.z);
+  static constexpr float kFarGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+  float org[3], inv[3], inv_far[3];
+  // Byte offsets, within a BvhNode, of the plane each slab enters and leaves by: the ray's
+  // direction signs are resolved once here, so the per-node test is loads and arithmetic only.
+  uint32_t near_off[3], far_off[3];
+  explicit RayBoxTest(const Ray& r) : org{r.org.x, r.org.y, r.org.z} {
+    for (int a = 0; a < 3; ++a) {
+      inv[a] = 1.0f / r.dir[a];
+      inv_far[a] = inv[a] * kFarGuard;
+      const bool neg = std::signbit(inv[a]);
+      near_off[a] = uint32_t((neg ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + sizeof(float) * size_t(a));
+      far_off[a] = uint32_t((neg ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + sizeof(float) * size_t(a));
+    }
   }
   // Entry distance, or +inf on a miss. tnear and tfar must not be NaN.
-  float enter(const Vec3& lo, const Vec3& hi, float tnear, float tfar) const {
+  float enter(const BvhNode& n, float tnear, float tfar) const {
     float t0;
-    return hit(lo, hi, tnear, tfar, t0) ? t0 : kInfinity;
+    return hit(n, tnear, tfar, t0) ? t0 : kInfinity;
   }
-  // Whether the ray enters the box within [tnear, tfar]; t0 receives the entry distance. No
-  // branch: traversal turns the two children's answers into its next step with plain arithmetic.
-  bool hit(const Vec3& lo, const Vec3& hi, float tnear, float tfar, float& t0_out) const {
-    constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
-    float t0 = tnear, t1 = tfar * kTieGuard;
-    const auto slab = [&](float l, float h, float o, float i, bool neg) {
-      const float n = ((neg ? h : l) - o) * i;
-      const float f = ((neg ? l : h) - o) * i * kGuard;
-      t0 = n > t0 ? n : t0;  // NaN n leaves t0 alone
-      t1 = f < t1 ? f : t1;  // NaN f leaves t1 alone
+  // Whether the ray enters the node's box within [tnear, tfar]; t0 receives the entry distance.
+  // No branch: traversal turns the two children's answers into its next step with arithmetic.
+  bool hit(const BvhNode& n, float tnear, float tfar, float& t0_out) const {
+    const auto* base = reinterpret_cast<const unsigned char*>(&n);
+    const auto plane = [base](uint32_t off) {
+      float v;
+      std::memcpy(&v, base + off, sizeof v);
+      return v;
     };
-    slab(lo.x, hi.x, org.x, inv.x, neg_x);
-    slab(lo.y, hi.y, org.y, inv.y, neg_y);
-    slab(lo.z, hi.z, org.z, inv.z, neg_z);
+    float t0 = tnear, t1 = tfar * kTieGuard;
+    for (int a = 0; a < 3; ++a) {
+      const float near = (plane(near_off[a]) - org[a]) * inv[a];
+      const float far = (plane(far_off[a]) - org[a]) * inv_far[a];
+      t0 = near > t0 ? near : t0;  // NaN leaves t0 alone
+      t1 = far < t1 ? far : t1;    // NaN leaves t1 alone
+    }
     t0_out = t0;
     return t0 <= t1;
   }

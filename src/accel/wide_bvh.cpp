@@ -19,12 +19,15 @@ namespace hn = hwy::HWY_NAMESPACE;
 // Per-ray constants of the slab test: the same arithmetic as the scalar RayBoxTest, so a child
 // is kept exactly when the binary tree would keep it (NaN from 0*inf never culls).
 struct WideRay {
-  float ox, oy, oz, ix, iy, iz;
+  float ox, oy, oz, ix, iy, iz, fx, fy, fz;  // origin, reciprocal direction, and the latter times kFarGuard
   bool nx, ny, nz;
   explicit WideRay(const Ray& r) : ox(r.org.x), oy(r.org.y), oz(r.org.z) {
     ix = 1.0f / r.dir.x;
     iy = 1.0f / r.dir.y;
     iz = 1.0f / r.dir.z;
+    fx = ix * RayBoxTest::kFarGuard;
+    fy = iy * RayBoxTest::kFarGuard;
+    fz = iz * RayBoxTest::kFarGuard;
     nx = std::signbit(ix);
     ny = std::signbit(iy);
     nz = std::signbit(iz);
@@ -33,7 +36,6 @@ struct WideRay {
 
 // Tests all children of `n`; writes their entry distances to t_out and returns one bit per child hit.
 HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar, float* HWY_RESTRICT t_out) {
-  constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
   const hn::CappedTag<float, kWideWidth> d;
   const size_t lanes = hn::Lanes(d);
   const float* near_x = r.nx ? n.hi_x : n.lo_x;
@@ -44,7 +46,7 @@ HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnea
   const float* far_z = r.nz ? n.lo_z : n.hi_z;
   const auto ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
   const auto ix = hn::Set(d, r.ix), iy = hn::Set(d, r.iy), iz = hn::Set(d, r.iz);
-  const auto guard = hn::Set(d, kGuard);
+  const auto fx = hn::Set(d, r.fx), fy = hn::Set(d, r.fy), fz = hn::Set(d, r.fz);
   const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar * RayBoxTest::kTieGuard);
   uint32_t bits = 0;
   for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
@@ -55,9 +57,9 @@ HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnea
     t0 = hn::IfThenElse(a > t0, a, t0);  // NaN compares false: no cull
     t0 = hn::IfThenElse(b > t0, b, t0);
     t0 = hn::IfThenElse(c > t0, c, t0);
-    const auto e = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_x + i), ox), ix), guard);
-    const auto f = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_y + i), oy), iy), guard);
-    const auto g = hn::Mul(hn::Mul(hn::Sub(hn::Load(d, far_z + i), oz), iz), guard);
+    const auto e = hn::Mul(hn::Sub(hn::Load(d, far_x + i), ox), fx);
+    const auto f = hn::Mul(hn::Sub(hn::Load(d, far_y + i), oy), fy);
+    const auto g = hn::Mul(hn::Sub(hn::Load(d, far_z + i), oz), fz);
     t1 = hn::IfThenElse(e < t1, e, t1);
     t1 = hn::IfThenElse(f < t1, f, t1);
     t1 = hn::IfThenElse(g < t1, g, t1);

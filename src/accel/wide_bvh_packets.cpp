@@ -24,6 +24,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 struct PacketState {
   HWY_ALIGN float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
   HWY_ALIGN float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];    // reciprocal direction
+  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times RayBoxTest::kFarGuard
   HWY_ALIGN int32_t nx[kPacketSize], ny[kPacketSize], nz[kPacketSize];  // -1 where that reciprocal is negative
   HWY_ALIGN float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];    // shear constants (RayShear)
   HWY_ALIGN float tnear[kPacketSize];
@@ -56,13 +57,12 @@ HWY_INLINE hn::Mask<D> LaneMask(D d, uint32_t bits) {
 // their closest hit, and the entry distance of the first of them (the visiting order: in a
 // coherent packet one ray's order is the packet's, and it costs no reduction across lanes).
 HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState& st, uint32_t mask, float& entry) {
-  constexpr float kGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const auto lo_x = hn::Set(d, n.lo_x[c]), lo_y = hn::Set(d, n.lo_y[c]), lo_z = hn::Set(d, n.lo_z[c]);
   const auto hi_x = hn::Set(d, n.hi_x[c]), hi_y = hn::Set(d, n.hi_y[c]), hi_z = hn::Set(d, n.hi_z[c]);
-  const auto guard = hn::Set(d, kGuard), tie = hn::Set(d, RayBoxTest::kTieGuard);
+  const auto tie = hn::Set(d, RayBoxTest::kTieGuard);
   HWY_ALIGN float t0s[kPacketSize];
   uint32_t hits = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
@@ -81,9 +81,9 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
     t0 = hn::IfThenElse(hn::Gt(a, t0), a, t0);  // NaN compares false: no cull, as in RayBoxTest
     t0 = hn::IfThenElse(hn::Gt(b, t0), b, t0);
     t0 = hn::IfThenElse(hn::Gt(e, t0), e, t0);
-    const auto f = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negx, lo_x, hi_x), ox), ix), guard);
-    const auto g = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negy, lo_y, hi_y), oy), iy), guard);
-    const auto h = hn::Mul(hn::Mul(hn::Sub(hn::IfThenElse(negz, lo_z, hi_z), oz), iz), guard);
+    const auto f = hn::Mul(hn::Sub(hn::IfThenElse(negx, lo_x, hi_x), ox), hn::Load(d, st.fx + i));
+    const auto g = hn::Mul(hn::Sub(hn::IfThenElse(negy, lo_y, hi_y), oy), hn::Load(d, st.fy + i));
+    const auto h = hn::Mul(hn::Sub(hn::IfThenElse(negz, lo_z, hi_z), oz), hn::Load(d, st.fz + i));
     t1 = hn::IfThenElse(hn::Lt(f, t1), f, t1);
     t1 = hn::IfThenElse(hn::Lt(g, t1), g, t1);
     t1 = hn::IfThenElse(hn::Lt(h, t1), h, t1);
@@ -196,12 +196,15 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
     st.oy[lane] = r.org.y;
     st.oz[lane] = r.org.z;
     const RayBoxTest box(r);
-    st.ix[lane] = box.inv.x;
-    st.iy[lane] = box.inv.y;
-    st.iz[lane] = box.inv.z;
-    st.nx[lane] = box.neg_x ? -1 : 0;
-    st.ny[lane] = box.neg_y ? -1 : 0;
-    st.nz[lane] = box.neg_z ? -1 : 0;
+    st.ix[lane] = box.inv[0];
+    st.iy[lane] = box.inv[1];
+    st.iz[lane] = box.inv[2];
+    st.fx[lane] = box.inv_far[0];
+    st.fy[lane] = box.inv_far[1];
+    st.fz[lane] = box.inv_far[2];
+    st.nx[lane] = std::signbit(box.inv[0]) ? -1 : 0;
+    st.ny[lane] = std::signbit(box.inv[1]) ? -1 : 0;
+    st.nz[lane] = std::signbit(box.inv[2]) ? -1 : 0;
     st.sx[lane] = shear.sx;
     st.sy[lane] = shear.sy;
     st.sz[lane] = shear.sz;
