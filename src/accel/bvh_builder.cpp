@@ -42,6 +42,7 @@ struct BuildNode {
   uint32_t begin = 0, end = 0;
   uint32_t left = kNone;  // children at left and left+1, or kNone for a leaf
   uint32_t depth = 0;
+  uint32_t subtree = 0;       // nodes in this subtree, itself included; 0 until its build ends
   Aabb cbox;                  // bounds of the centroids
   bool bounds_known = false;  // box and cbox already computed by the parent's partition pass
   uint8_t buffer = 0;         // which of the two PrimRef buffers holds [begin, end)
@@ -160,37 +161,17 @@ class BvhBuilder {
   }
 
   // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
-  // triangle index of every leaf slot.
-  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids) const {
+  // triangle index of every leaf slot. Each subtree's place follows from its size alone, so the
+  // tasks build flattens its large subtrees in parallel into the same layout.
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids) {
     ids.resize(count_);
     out.resize(count_ == 0 ? 0 : node_count_.load() + 1);  // + the padding node
     if (count_ == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
-    struct Item { uint32_t build, flat; };
-    Item stack[2 * Bvh::kMaxDepth + 2];
-    int sp = 0;
-    stack[sp++] = {0, 0};
-    uint32_t next = 2;
-    while (sp > 0) {
-      const Item it = stack[--sp];
-      const BuildNode& n = nodes_[it.build];
-      BvhNode& f = out[it.flat];
-      f.lo = n.box.lo;
-      f.hi = n.box.hi;
-      if (n.left == kNone) {
-        f.index = n.begin;
-        f.count = n.end - n.begin;
-        const PrimRef* refs = buffers_[n.buffer].get();
-        for (uint32_t i = n.begin; i < n.end; ++i) ids[i] = refs[i].id();
-      } else {
-        f.index = next;
-        f.count = 0;
-        // Push right first so the left subtree is laid out right after its parent.
-        stack[sp++] = {n.left + 1, next + 1};
-        stack[sp++] = {n.left, next};
-        next += 2;
-      }
-    }
+    subtree_size(0);                 // fills in sizes the queue build left unknown at the top
+    publish();
+    place(out.data(), ids.data(), 0, 0, 2, options_.mode == BuildMode::Tasks);
+    publish();
   }
 
  private:
@@ -200,16 +181,18 @@ class BvhBuilder {
   }
 
   void build_seq(uint32_t id) {
-    if (!split(id, false)) return;
-    const uint32_t left = nodes_[id].left;
-    build_seq(left);
-    build_seq(left + 1);
+    if (split(id, false)) {
+      const uint32_t left = nodes_[id].left;
+      build_seq(left);
+      build_seq(left + 1);
+    }
+    finish(id);
   }
 
   // The study's v1: one std::async per recursive call, but only near the root and for large
   // subtrees, so it never starts a thread per node.
   void build_async(uint32_t id, int depth_left) {
-    if (!split(id, false)) return;
+    if (!split(id, false)) return finish(id);
     const uint32_t left = nodes_[id].left;
     const BuildNode& l = nodes_[left];
     if (depth_left > 0 && l.end - l.begin >= kParallelSubtree) {
@@ -220,6 +203,7 @@ class BvhBuilder {
       build_seq(left);
       build_seq(left + 1);
     }
+    finish(id);
   }
 
   // The study's v2: workers take node jobs from a shared FIFO. The lock covers only push/pop;
@@ -268,11 +252,12 @@ class BvhBuilder {
       build_seq(id);
       return;
     }
-    if (!split(id, size >= kParallelSplit)) return;
+    if (!split(id, size >= kParallelSplit)) return finish(id);
     const uint32_t left = nodes_[id].left;
     publish();  // the children's nodes and primitives, written above, to whichever thread takes them
     tbb::parallel_invoke([&] { publish(); build_tasks(left); publish(); }, [&] { publish(); build_tasks(left + 1); publish(); });
     publish();
+    finish(id);
   }
 
   // TBB's own forks and joins happen inside a library ThreadSanitizer cannot see into. Every
@@ -282,6 +267,44 @@ class BvhBuilder {
   // processes, every node and primitive handed between threads: minutes per build).
   // A few atomics per task or data-parallel chunk, never per node or primitive.
   void publish() const { sync_.fetch_add(1, std::memory_order_acq_rel); }
+
+  // Ends a node's build: records its subtree's size once its children's are known.
+  void finish(uint32_t id) {
+    BuildNode& n = nodes_[id];
+    n.subtree = n.left == kNone ? 1 : 1 + nodes_[n.left].subtree + nodes_[n.left + 1].subtree;
+  }
+
+  uint32_t subtree_size(uint32_t id) {
+    BuildNode& n = nodes_[id];
+    if (n.subtree == 0) n.subtree = n.left == kNone ? 1 : 1 + subtree_size(n.left) + subtree_size(n.left + 1);
+    return n.subtree;
+  }
+
+  // Writes build node `id` to out[flat] and its descendants, depth first, from out[next] on.
+  void place(BvhNode* out, uint32_t* ids, uint32_t id, uint32_t flat, uint32_t next, bool parallel) const {
+    const BuildNode& n = nodes_[id];
+    BvhNode& f = out[flat];
+    f.lo = n.box.lo;
+    f.hi = n.box.hi;
+    if (n.left == kNone) {
+      f.index = n.begin;
+      f.count = n.end - n.begin;
+      const PrimRef* refs = buffers_[n.buffer].get();
+      for (uint32_t i = n.begin; i < n.end; ++i) ids[i] = refs[i].id();
+      return;
+    }
+    f.index = next;
+    f.count = 0;
+    const uint32_t left = n.left, right_next = next + 2 + (nodes_[left].subtree - 1);
+    const auto place_left = [&] { place(out, ids, left, next, next + 2, parallel); };
+    const auto place_right = [&] { place(out, ids, left + 1, next + 1, right_next, parallel); };
+    if (parallel && n.end - n.begin >= kParallelSubtree) {
+      tbb::parallel_invoke([&] { publish(); place_left(); publish(); }, [&] { publish(); place_right(); publish(); });
+    } else {
+      place_left();
+      place_right();
+    }
+  }
 
   template <class Body, class T>
   T reduce_range(uint32_t begin, uint32_t end, bool parallel, T init, const Body& body) const {
