@@ -444,9 +444,8 @@ class BvhBuilder {
     float half_area() const {
       const __m128 e = _mm_and_ps(_mm_sub_ps(hi, lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
       const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy, yz, zx, 0
-      alignas(16) float a[4];
-      _mm_store_ps(a, p);
-      return a[0] + a[1] + a[2];
+      const __m128 xy_yz = _mm_add_ss(p, _mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1)));
+      return _mm_cvtss_f32(_mm_add_ss(xy_yz, _mm_movehl_ps(p, p)));  // (xy + yz) + zx
     }
   };
 
@@ -526,6 +525,7 @@ class BvhBuilder {
     SahChoice best;
     best.cost = kInfinity;
     const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
+    const float traversal_cost = options_.traversal_cost, intersection_cost = options_.intersection_cost;
     for (int a = 0; a < 3; ++a) {
       if (cbox.hi[a] <= cbox.lo[a]) continue;
       float right_cost[kMaxBins];  // area * count of bins [s, nb)
@@ -539,8 +539,7 @@ class BvhBuilder {
       for (int s = 1; s < nb; ++s) {
         acc.add(bins.bins[a][s - 1]);
         if (acc.count == 0) continue;
-        const float cost = options_.traversal_cost +
-                           options_.intersection_cost * (acc.half_area() * float(acc.count) + right_cost[s]) * inv_area;
+        const float cost = traversal_cost + intersection_cost * (acc.half_area() * float(acc.count) + right_cost[s]) * inv_area;
         if (cost < best.cost) best = {a, s, cost, nb, acc.count};
       }
     }
