@@ -22,9 +22,10 @@ struct RayShear {
     kx = kz == 2 ? 0 : kz + 1;
     ky = kx == 2 ? 0 : kx + 1;
     if (r.dir[kz] < 0.0f) std::swap(kx, ky);  // keep the winding so U, V, W keep their signs
-    sx = r.dir[kx] / r.dir[kz];
-    sy = r.dir[ky] / r.dir[kz];
+    // One division, not three: any shear works as long as every triangle sees the same one.
     sz = 1.0f / r.dir[kz];
+    sx = r.dir[kx] * sz;
+    sy = r.dir[ky] * sz;
   }
 };
 
