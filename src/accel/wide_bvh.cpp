@@ -135,11 +135,34 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
 }
 
 // Updates `hit` with the closest lane of `pack` (ties to the lower scene index, as everywhere).
+// The nearest of several hit lanes is found by a SIMD minimum over the lanes, not a loop; only
+// lanes tied exactly at that minimum (rare) are compared one by one for the lower index.
 HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, const uint32_t* ids, float tnear,
                               Hit& hit) {
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
-  for (uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv); bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
+  const uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv);
+  if (bits == 0) return;
+  uint32_t nearest = bits;
+  if (bits & (bits - 1)) {
+    const hn::CappedTag<float, kWideWidth> d;
+    const size_t lanes = hn::Lanes(d);
+    const auto inf = hn::Set(d, kInfinity);
+    const auto lane_mask = [&](size_t i) {
+      const uint8_t b[8] = {uint8_t(bits >> i), 0, 0, 0, 0, 0, 0, 0};
+      return hn::LoadMaskBits(d, b);
+    };
+    auto tmin = inf;
+    for (size_t i = 0; i < size_t(kWideWidth); i += lanes) tmin = hn::Min(tmin, hn::IfThenElse(lane_mask(i), hn::Load(d, tt + i), inf));
+    tmin = hn::MinOfLanes(d, tmin);
+    nearest = 0;
+    for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
+      uint8_t eq[8] = {0};
+      hn::StoreMaskBits(d, hn::And(lane_mask(i), hn::Eq(hn::Load(d, tt + i), tmin)), eq);
+      nearest |= uint32_t(eq[0]) << i;
+    }
+  }
+  for (; nearest; nearest &= nearest - 1) {  // one lane, unless several tie exactly
+    const int k = __builtin_ctz(nearest);
     const uint32_t id = ids[p.slot[k]];
     if (closer(tt[k], id, hit)) {
       hit.t = tt[k];
