@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstring>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -50,11 +52,22 @@ struct CacheAlignedAllocator {
   CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
   T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
   void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t{64}); }
+  // resize() leaves new elements uninitialised (they are plain implicit-lifetime aggregates the
+  // builder overwrites, in parallel): zeroing megabytes first cost as much as the flattening.
+  template <class U>
+  void construct(U*) noexcept {
+    static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>);
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
   template <class U>
   bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
 };
 
 using BvhNodeArray = std::vector<BvhNode, CacheAlignedAllocator<BvhNode>>;
+using TriangleArray = std::vector<Triangle, CacheAlignedAllocator<Triangle>>;
 
 struct BvhStats {
   size_t nodes = 0, leaves = 0, max_depth = 0, max_leaf_size = 0;
@@ -73,7 +86,7 @@ class Bvh {
 
   // nodes()[0] is the root; nodes()[1] is padding so sibling pairs start at even indices.
   const BvhNodeArray& nodes() const { return nodes_; }
-  const std::vector<Triangle>& triangles() const { return tris_; }
+  const TriangleArray& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }  // scene index per slot
   const BvhBuildOptions& options() const { return options_; }
   const Scene& scene() const { return *scene_; }
@@ -88,7 +101,7 @@ class Bvh {
   const Scene* scene_;
   BvhBuildOptions options_;
   BvhNodeArray nodes_;
-  std::vector<Triangle> tris_;
+  TriangleArray tris_;
   std::vector<uint32_t> ids_;
 };
 

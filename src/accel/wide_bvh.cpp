@@ -330,7 +330,7 @@ SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
   }
 }
 
-TrianglePack make_triangle_pack(const std::vector<Triangle>& triangles, uint32_t first, uint32_t count) {
+TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t first, uint32_t count) {
   TrianglePack p;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int lane = 0; lane < kWideWidth; ++lane) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,7 @@ class WideBvh {
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const std::vector<TrianglePack>& packs() const { return packs_; }
-  const std::vector<Triangle>& triangles() const { return tris_; }
+  const TriangleArray& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }
   size_t memory_bytes() const {
     return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) +
@@ -66,7 +67,7 @@ class WideBvh {
   const Scene* scene_;
   std::vector<WideNode> nodes_;
   std::vector<TrianglePack> packs_;
-  std::vector<Triangle> tris_;
+  TriangleArray tris_;
   std::vector<uint32_t> ids_;
 };
 
@@ -94,6 +95,6 @@ class SimdBruteForce {
 
 // Packs triangles[first, first+count) (count <= 8) into one TrianglePack; `slot` indices are
 // first + lane, padding lanes are NaN.
-TrianglePack make_triangle_pack(const std::vector<Triangle>& triangles, uint32_t first, uint32_t count);
+TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t first, uint32_t count);
 
 }  // namespace tracer
