@@ -75,6 +75,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --packets", 2, "--packets: needs --accel bvh8"},
       {"render --accel embree --packets", 2, "--packets: needs --accel bvh8"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
+      {"render --traversal-cost 0", 2, "--traversal-cost: must be above 0"},
+      {"render --traversal-cost nan", 2, "--traversal-cost"},
   };
   for (const CliCase& c : cases) {
     std::string args = c.args;

@@ -34,6 +34,8 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
   app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
   app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
+  app.add_option("--traversal-cost", a.traversal_cost, "SAH BVH: cost of a node step relative to a triangle test (0-100)")
+      ->capture_default_str();
   app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")->capture_default_str();
   app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
   app.add_flag("--packets", a.packets, "trace primary rays in 4x4-pixel packets (--accel bvh8); same image");
@@ -67,6 +69,7 @@ void validate(const RenderArgs& a) {
   check_range("--block", a.block, 1, 1 << 20);
   check_range("--max-leaf", a.max_leaf, 1, 16);
   check_range("--bins", a.bins, 4, 32);
+  check_range_real("--traversal-cost", a.traversal_cost, 0.0, 100.0, true);
   if (!a.eye.empty()) parse_vec3("--eye", a.eye);
   if (!a.look.empty()) parse_vec3("--look", a.look);
   if (!a.up.empty()) {
@@ -147,6 +150,7 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   o.bvh.threads = a.threads.value_or(0);
   o.bvh.max_leaf = a.max_leaf;
   o.bvh.bins = a.bins;
+  o.bvh.traversal_cost = float(a.traversal_cost);
   return o;
 }
 

@@ -34,6 +34,7 @@ struct RenderArgs {
   unsigned seed = 0;
   std::string accel = "bvh", split = "sah", build = "tasks";
   int max_leaf = 4, bins = 16;
+  double traversal_cost = 1.5;  // SAH: a node step relative to a triangle test
   std::string simd = "auto";
   std::string simd_target = "auto";
   bool packets = false;
