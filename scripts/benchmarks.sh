@@ -54,4 +54,11 @@ done
 build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console \
   --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Primary1024/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/microbench.txt"
+# Builds per scene, split and builder, five repetitions each (medians for section 4).
+build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/(Sphere|Water|Sponza|Sibenik)/' \
+  --benchmark_repetitions=5 --benchmark_report_aggregates_only=true 2>/dev/null | tee "$O/build-all.txt"
+# The BVH issue's build target: the Bunny's SAH build against Embree's, twelve repetitions each
+# (single builds on this shared VM vary by several milliseconds; compare minima and medians).
+build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/Bunny/(sah/(seq|tasks)|embree)' \
+  --benchmark_repetitions=12 --benchmark_format=console 2>/dev/null | tee "$O/build-bunny.txt"
 echo "figures written to $O/"
