@@ -18,6 +18,7 @@ namespace {
 
 struct RecordedRays {
   std::vector<Ray> primary, shadow, ao;
+  std::vector<uint32_t> shadow_from, ao_from;  // the triangle each shadow / AO ray leaves
 };
 
 // Records the workload's rays by rendering with a recording accelerator over the SAH BVH.
@@ -28,10 +29,13 @@ struct Recorder {
     out->primary.push_back(r);
     return bvh->intersect(r, h);
   }
-  bool occluded(const Ray& r) const {
+  bool occluded(const Ray& r) const { return bvh->occluded(r); }
+  bool occluded_from(const Ray& r, uint32_t origin) const {
     // Shadow rays stop short of their light (finite tfar); AO rays here have tfar = infinity.
-    (r.tfar == kInfinity ? out->ao : out->shadow).push_back(r);
-    return bvh->occluded(r);
+    const bool ao = r.tfar == kInfinity;
+    (ao ? out->ao : out->shadow).push_back(r);
+    (ao ? out->ao_from : out->shadow_from).push_back(origin);
+    return bvh->occluded_from(r, origin);
   }
 };
 
@@ -192,17 +196,27 @@ void register_dynamic() {
     if (embree_available()) accels.emplace_back("embree", AccelOptions{.kind = AccelKind::Embree});
     for (const auto& [accel_name, options] : accels) {
       auto accel = std::make_shared<Accelerator>(build_accelerator(*c.scene, options));
-      for (int kind = 0; kind < 3; ++kind) {
-        static const char* kinds[] = {"primary", "shadow", "ao"};
+      // Shadow and AO rays go through occluded_leaving(), as in the renderer: the binary BVH starts
+      // them at their origin triangle's leaf. "ao-from-root" is the same AO rays from the root.
+      for (int kind = 0; kind < 4; ++kind) {
+        static const char* kinds[] = {"primary", "shadow", "ao", "ao-from-root"};
+        if (kind == 3 && options.kind != AccelKind::Bvh) continue;
         const std::vector<Ray>* rays = kind == 0 ? &c.rays.primary : (kind == 1 ? &c.rays.shadow : &c.rays.ao);
+        const std::vector<uint32_t>* from = kind == 1 ? &c.rays.shadow_from : &c.rays.ao_from;
         if (rays->empty()) continue;
         const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind];
-        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, kind](benchmark::State& st) {
+        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, from, kind](benchmark::State& st) {
           size_t n = 0;
           accel->visit([&](const auto& a) {
             Hit h;
             for (auto _ : st) {
-              for (const Ray& r : *rays) n += kind == 0 ? a.intersect(r, h) : a.occluded(r);
+              if (kind == 0) {
+                for (const Ray& r : *rays) n += a.intersect(r, h);
+              } else if (kind == 3) {
+                for (const Ray& r : *rays) n += a.occluded(r);
+              } else {
+                for (size_t i = 0; i < rays->size(); ++i) n += occluded_leaving(a, (*rays)[i], (*from)[i]);
+              }
             }
           });
           benchmark::DoNotOptimize(n);

@@ -53,6 +53,7 @@ RaySet rays_for(const Scene& scene, size_t random_count, int image) {
 struct Reference {
   std::vector<Hit> hits;
   std::vector<uint8_t> occluded;
+  std::vector<uint8_t> occluded_from;  // the binary BVH's bottom-up query, from scattered origins
 };
 
 template <class A>
@@ -62,6 +63,16 @@ Reference answers(const A& accel, const RaySet& rays) {
   ref.occluded.resize(rays.any.size());
   tbb::parallel_for(size_t(0), rays.closest.size(), [&](size_t i) { accel.intersect(rays.closest[i], ref.hits[i]); });
   tbb::parallel_for(size_t(0), rays.any.size(), [&](size_t i) { ref.occluded[i] = accel.occluded(rays.any[i]) ? 1 : 0; });
+  if constexpr (requires { accel.occluded_from(Ray{}, 0u); }) {
+    // Its answer must not depend on the origin triangle: any triangle, a degenerate one, or an
+    // index past the end (which falls back to the root) must all agree with occluded().
+    const auto tris = uint32_t(accel.scene().size());
+    ref.occluded_from.resize(rays.any.size());
+    tbb::parallel_for(size_t(0), rays.any.size(), [&](size_t i) {
+      const auto origin = uint32_t((uint64_t(i) * 2654435761u) % (uint64_t(tris) + 1));
+      ref.occluded_from[i] = accel.occluded_from(rays.any[i], origin) ? 1 : 0;
+    });
+  }
   return ref;
 }
 
@@ -79,6 +90,9 @@ size_t compare(const Reference& expected, const Reference& got, const std::strin
   }
   for (size_t i = 0; i < expected.occluded.size(); ++i) {
     if (expected.occluded[i] != got.occluded[i] && bad++ < 3) ADD_FAILURE() << what << ": occluded ray " << i << " differs";
+  }
+  for (size_t i = 0; i < got.occluded_from.size(); ++i) {
+    if (expected.occluded[i] != got.occluded_from[i] && bad++ < 3) ADD_FAILURE() << what << ": occluded_from ray " << i << " differs";
   }
   return bad;
 }

@@ -57,34 +57,31 @@ done:
   return finish_hit(*scene_, hit);
 }
 
-bool Bvh::occluded(const Ray& ray) const {
-  if (nodes_.empty()) return false;
-  const RayShear shear(ray);
-  const RayBoxTest box(ray);
-  if (box.enter(nodes_[0], ray.tnear, ray.tfar) == kInfinity) return false;
+// Any hit below `node`, whose own box the caller has already found the ray entering.
+inline bool Bvh::occluded_below(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const {
   uint32_t stack[kMaxDepth + 2];
   int sp = 0;
-  uint32_t current = 0;
+  uint32_t current = node;
   for (;;) {
-    const BvhNode& node = nodes_[current];
-    if (node.leaf()) {
+    const BvhNode& n = nodes_[current];
+    if (n.leaf()) {
       TriangleHit th;
-      for (uint32_t i = node.index, end = node.index + node.count; i < end; ++i) {
+      for (uint32_t i = n.index, end = n.index + n.count; i < end; ++i) {
         if (intersect_triangle(shear, tris_[i], ray.tnear, ray.tfar, th)) return true;
       }
     } else {
       // Children are tested from the parent. Any hit ends the query, so no order is needed:
       // the left child goes first, the right one is pushed when both are entered.
-      const BvhNode& a = nodes_[node.index];
-      const BvhNode& b = nodes_[node.index + 1];
+      const BvhNode& a = nodes_[n.index];
+      const BvhNode& b = nodes_[n.index + 1];
       __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris_[a.index]) : &nodes_[a.index]);
       __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris_[b.index]) : &nodes_[b.index]);
       float a0, b0;
       const bool ha = box.hit(a, ray.tnear, ray.tfar, a0);
       const bool hb = box.hit(b, ray.tnear, ray.tfar, b0);
       if (ha | hb) {
-        current = node.index + uint32_t(!ha);
-        stack[sp] = node.index + 1;
+        current = n.index + uint32_t(!ha);
+        stack[sp] = n.index + 1;
         sp += int(ha & hb);
         continue;
       }
@@ -92,6 +89,34 @@ bool Bvh::occluded(const Ray& ray) const {
     if (sp == 0) return false;
     current = stack[--sp];
   }
+}
+
+bool Bvh::occluded(const Ray& ray) const {
+  if (nodes_.empty()) return false;
+  const RayShear shear(ray);
+  const RayBoxTest box(ray);
+  if (box.enter(nodes_[0], ray.tnear, ray.tfar) == kInfinity) return false;
+  return occluded_below(0, ray, shear, box);
+}
+
+bool Bvh::occluded_from(const Ray& ray, uint32_t origin) const {
+  if (origin >= leaf_of_.size() || leaf_of_[origin] == kNoLeaf) return occluded(ray);
+  const RayShear shear(ray);
+  const RayBoxTest box(ray);
+  // A ray that misses the scene's box (leaving an outer surface outwards) is answered at once,
+  // as top-down traversal would.
+  if (box.enter(nodes_[0], ray.tnear, ray.tfar) == kInfinity) return false;
+  // Every node off the path from the root to `origin`'s leaf lies below exactly one sibling of
+  // that path, so the leaf plus those siblings' subtrees cover the whole tree.
+  uint32_t node = leaf_of_[origin];
+  if (occluded_below(node, ray, shear, box)) return true;
+  while (node != 0) {
+    const uint32_t sibling = node ^ 1u;
+    node = pair_parent_[node >> 1];
+    float t0;
+    if (box.hit(nodes_[sibling], ray.tnear, ray.tfar, t0) && occluded_below(sibling, ray, shear, box)) return true;
+  }
+  return false;
 }
 
 BvhStats Bvh::stats() const {
@@ -146,10 +171,14 @@ std::string Bvh::validate() const {
         if (!box.contains(tris_[i].bounds())) return "leaf " + std::to_string(it.node) + " box does not contain triangle " + std::to_string(ids_[i]);
         if (ids_[i] >= seen.size()) return "triangle id out of range";
         ++seen[ids_[i]];
+        if (leaf_of_.size() != seen.size() || leaf_of_[ids_[i]] != it.node) return "leaf_of does not name the leaf of triangle " + std::to_string(ids_[i]);
         if (!(scene_->triangles[ids_[i]].v0 == tris_[i].v0)) return "reordered triangle differs from scene";
       }
     } else {
       if (size_t(n.index) + 1 >= nodes_.size()) return "child index out of range";
+      if (n.index % 2 != 0 || pair_parent_.size() <= n.index / 2 || pair_parent_[n.index / 2] != it.node) {
+        return "node " + std::to_string(it.node) + " is not its children's recorded parent";
+      }
       for (uint32_t c = n.index; c <= n.index + 1; ++c) {
         if (!box.contains(Aabb{nodes_[c].lo, nodes_[c].hi})) return "node " + std::to_string(it.node) + " does not contain child " + std::to_string(c);
         stack.push_back({c, it.depth + 1});
@@ -158,6 +187,7 @@ std::string Bvh::validate() const {
   }
   for (size_t i = 0; i < seen.size(); ++i) {
     const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
+    if (expected == 0 && leaf_of_.size() == seen.size() && leaf_of_[i] != kNoLeaf) return "degenerate triangle " + std::to_string(i) + " has a leaf";
     if (seen[i] != expected) {
       err << "triangle " << i << " appears in " << seen[i] << " leaves, expected " << expected;
       return err.str();

@@ -75,6 +75,8 @@ struct BvhStats {
   double avg_leaf_size = 0.0;
 };
 
+struct RayBoxTest;
+
 class Bvh {
  public:
   static constexpr int kMaxDepth = 96;  // the builder guarantees it; traversal stacks rely on it
@@ -83,6 +85,11 @@ class Bvh {
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
+  // occluded() for a ray leaving scene triangle `origin` (a shadow or AO ray): the same answer,
+  // found bottom-up from the leaf holding `origin`, testing only the sibling subtree at each
+  // level, so the boxes on the path down to the ray's own surface (which it starts inside) are
+  // neither tested nor stacked. Any `origin` gives the right answer; the right one is fastest.
+  bool occluded_from(const Ray& ray, uint32_t origin) const;
 
   // nodes()[0] is the root; nodes()[1] is padding so sibling pairs start at even indices.
   const BvhNodeArray& nodes() const { return nodes_; }
@@ -92,17 +99,23 @@ class Bvh {
   const Scene& scene() const { return *scene_; }
   BvhStats stats() const;
   size_t memory_bytes() const {
-    return nodes_.size() * sizeof(BvhNode) + tris_.size() * sizeof(Triangle) + ids_.size() * sizeof(uint32_t);
+    return nodes_.size() * sizeof(BvhNode) + tris_.size() * sizeof(Triangle) +
+           (ids_.size() + pair_parent_.size() + leaf_of_.size()) * sizeof(uint32_t);
   }
   // Checks the tree's invariants; returns an empty string when they hold, else the first violation.
   std::string validate() const;
 
  private:
+  static constexpr uint32_t kNoLeaf = 0xffffffffu;
+  bool occluded_below(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const;
+
   const Scene* scene_;
   BvhBuildOptions options_;
   BvhNodeArray nodes_;
   TriangleArray tris_;
   std::vector<uint32_t> ids_;
+  std::vector<uint32_t> pair_parent_;  // parent of the sibling pair nodes_[2k], nodes_[2k+1], at k
+  std::vector<uint32_t> leaf_of_;      // leaf holding each scene triangle (kNoLeaf: degenerate)
 };
 
 // Slab test with a per-ray reciprocal direction (Williams et al. 2005, as pbrt does it): a zero

@@ -163,14 +163,17 @@ class BvhBuilder {
   // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
   // triangle index of every leaf slot. Each subtree's place follows from its size alone, so the
   // tasks build flattens its large subtrees in parallel into the same layout.
-  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids) {
+  // `pair_parent` receives each sibling pair's parent, `leaf_of` each scene triangle's leaf.
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent, std::vector<uint32_t>& leaf_of) {
     ids.resize(count_);
     out.resize(count_ == 0 ? 0 : node_count_.load() + 1);  // + the padding node
+    pair_parent.assign((out.size() + 1) / 2, 0);
     if (count_ == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
     subtree_size(0);                 // fills in sizes the queue build left unknown at the top
     publish();
-    place(out.data(), ids.data(), 0, 0, 2, options_.mode == BuildMode::Tasks);
+    const Output o{out.data(), ids.data(), pair_parent.data(), leaf_of.data()};
+    place(o, 0, 0, 2, options_.mode == BuildMode::Tasks);
     publish();
   }
 
@@ -280,24 +283,35 @@ class BvhBuilder {
     return n.subtree;
   }
 
-  // Writes build node `id` to out[flat] and its descendants, depth first, from out[next] on.
-  void place(BvhNode* out, uint32_t* ids, uint32_t id, uint32_t flat, uint32_t next, bool parallel) const {
+  struct Output {
+    BvhNode* nodes;
+    uint32_t* ids;
+    uint32_t* pair_parent;
+    uint32_t* leaf_of;
+  };
+
+  // Writes build node `id` to out.nodes[flat] and its descendants, depth first, from [next] on.
+  void place(const Output& out, uint32_t id, uint32_t flat, uint32_t next, bool parallel) const {
     const BuildNode& n = nodes_[id];
-    BvhNode& f = out[flat];
+    BvhNode& f = out.nodes[flat];
     f.lo = n.box.lo;
     f.hi = n.box.hi;
     if (n.left == kNone) {
       f.index = n.begin;
       f.count = n.end - n.begin;
       const PrimRef* refs = buffers_[n.buffer].get();
-      for (uint32_t i = n.begin; i < n.end; ++i) ids[i] = refs[i].id();
+      for (uint32_t i = n.begin; i < n.end; ++i) {
+        out.ids[i] = refs[i].id();
+        out.leaf_of[refs[i].id()] = flat;
+      }
       return;
     }
     f.index = next;
     f.count = 0;
+    out.pair_parent[next / 2] = flat;
     const uint32_t left = n.left, right_next = next + 2 + (nodes_[left].subtree - 1);
-    const auto place_left = [&] { place(out, ids, left, next, next + 2, parallel); };
-    const auto place_right = [&] { place(out, ids, left + 1, next + 1, right_next, parallel); };
+    const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
+    const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
     if (parallel && n.end - n.begin >= kParallelSubtree) {
       tbb::parallel_invoke([&] { publish(); place_left(); publish(); }, [&] { publish(); place_right(); publish(); });
     } else {
@@ -645,7 +659,8 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
   const auto construct = [&] {
     BvhBuilder builder(scene, options);
     builder.build();
-    builder.flatten(nodes_, ids_);
+    leaf_of_.assign(scene.size(), kNoLeaf);
+    builder.flatten(nodes_, ids_, pair_parent_, leaf_of_);
     tris_.resize(ids_.size());
     const auto copy = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];

@@ -79,6 +79,17 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
 template <class A>
 concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) { a.intersect_packet(p, h); };
 
+// An occlusion query for a ray leaving scene triangle `origin`: accelerators that can start the
+// search at that triangle's leaf (the binary BVH) do; the others search from the root.
+template <class Accel>
+bool occluded_leaving(const Accel& accel, const Ray& ray, uint32_t origin) {
+  if constexpr (requires { accel.occluded_from(ray, origin); }) {
+    return accel.occluded_from(ray, origin);
+  } else {
+    return accel.occluded(ray);
+  }
+}
+
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
 template <class Accel>
 Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit, RayCounts& counts) {
@@ -114,7 +125,7 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
     shadow.dir = wi;
     shadow.tfar = d * (1.0f - 1e-4f);  // stop short of the light's own surface
     ++counts.shadow;
-    if (accel.occluded(shadow)) continue;
+    if (occluded_leaving(accel, shadow, hit.tri)) continue;
     color += albedo_over_pi * light.power * (falloff * cos_surface);
   }
 
@@ -128,7 +139,7 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
       ao.org = origin;
       ao.dir = ao_direction(n, rng.draw(0), rng.draw(1));
       ao.tfar = s.ao_distance;
-      open += accel.occluded(ao) ? 0 : 1;
+      open += occluded_leaving(accel, ao, hit.tri) ? 0 : 1;
     }
     counts.ao += uint64_t(s.ao_samples);
     unoccluded = float(open) / float(s.ao_samples);
