@@ -72,8 +72,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --simd maybe", 2, "--simd: expected auto or off, got 'maybe'"},
       {"render --accel bvh8 --simd off", 2, "--simd off: bvh8 is the SIMD tree"},
       {"render --simd-target neon", 2, "--simd-target: unknown target 'neon'"},
-      {"render --packets", 2, "--packets: needs --accel bvh8"},
-      {"render --accel embree --packets", 2, "--packets: needs --accel bvh8"},
+      {"render --accel brute --packets", 2, "--packets: needs --accel bvh or bvh8"},
+      {"render --accel embree --packets", 2, "--packets: needs --accel bvh or bvh8"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
       {"render --traversal-cost 0", 2, "--traversal-cost: must be above 0"},
       {"render --traversal-cost nan", 2, "--traversal-cost"},
@@ -132,6 +132,10 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   const std::string ptext((std::istreambuf_iterator<char>(pjson)), {});
   EXPECT_NE(ptext.find("\"packets\": true"), std::string::npos) << ptext;
   EXPECT_NE(ptext.find("\"primary\": 192"), std::string::npos) << ptext;
+  // The binary BVH with AO bundles: the same image.
+  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --packets -o " + dir_ + "/b.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/b.png").rgb, png.rgb);
   r = test::run_tracer("info " + scene);
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.output.find("triangles   1"), std::string::npos) << r.output;

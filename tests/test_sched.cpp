@@ -91,8 +91,9 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
 }
 
 TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
-  // The 8-wide BVH, with and without primary-ray packets, against the scalar BVH's image; tile
-  // sizes not a multiple of the 4x4 packet leave partial packets at every tile's edge.
+  // The 8-wide BVH with and without packets (primary rays in 4x4 packets, AO rays in bundles),
+  // and the binary BVH with AO bundles, against the scalar BVH's image; tile sizes not a
+  // multiple of the 4x4 packet leave partial packets at every tile's edge.
   const int size = int(test::ray_budget(100'000) >= 100'000 ? 48 : 24);
   for (const Scene& scene : scenes()) {
     SCOPED_TRACE(scene.source);
@@ -100,15 +101,18 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
     seq.kind = SchedKind::Seq;
     const Rendered reference = render_with(scene, build_accelerator(scene, AccelOptions{}), seq, size);
     const Accelerator wide = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh8});
+    const Accelerator binary = build_accelerator(scene, AccelOptions{});
     for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
-      for (const bool packets : {false, true}) {
+      for (const int variant : {0, 1, 2}) {
+        const bool packets = variant > 0;
         SchedOptions so;
         so.kind = kind;
         so.threads = 2;
         so.tile = 7;
         so.block = 30;
-        SCOPED_TRACE(to_string(kind) + (packets ? " packets" : " single rays"));
-        const Rendered r = render_with(scene, wide, so, size, packets);
+        static const char* names[] = {" bvh8 single rays", " bvh8 packets", " bvh bundles"};
+        SCOPED_TRACE(to_string(kind) + names[variant]);
+        const Rendered r = render_with(scene, variant == 2 ? binary : wide, so, size, packets);
         EXPECT_EQ(r.rgb, reference.rgb);
         EXPECT_EQ(r.counts.total(), reference.counts.total());
       }

@@ -13,6 +13,7 @@
 
 #include "accel/triangle_test.hpp"
 #include "math/aabb.hpp"
+#include "math/ray_packet.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -90,6 +91,11 @@ class Bvh {
   // level, so the boxes on the path down to the ray's own surface (which it starts inside) are
   // neither tested nor stacked. Any `origin` gives the right answer; the right one is fastest.
   bool occluded_from(const Ray& ray, uint32_t origin) const;
+  // occluded_from() for all the rays of a bundle (the AO rays of one shading point), which leave
+  // `origin` from one point: returns the bits of rays.active whose rays are occluded, each the
+  // answer its ray gets alone. The walk up from the origin's leaf, which the rays share, is made
+  // once for all of them, one SIMD lane per ray (bvh_bundles.cpp).
+  uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
 
   // nodes()[0] is the root; nodes()[1] is padding so sibling pairs start at even indices.
   const BvhNodeArray& nodes() const { return nodes_; }
@@ -97,6 +103,9 @@ class Bvh {
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }  // scene index per slot
   const BvhBuildOptions& options() const { return options_; }
   const Scene& scene() const { return *scene_; }
+  static constexpr uint32_t kNoLeaf = 0xffffffffu;
+  const std::vector<uint32_t>& pair_parents() const { return pair_parent_; }  // parent of pair nodes[2k], nodes[2k+1], at k
+  const std::vector<uint32_t>& leaf_of() const { return leaf_of_; }  // leaf of each scene triangle (kNoLeaf: degenerate)
   BvhStats stats() const;
   size_t memory_bytes() const {
     return nodes_.size() * sizeof(BvhNode) + tris_.size() * sizeof(Triangle) +
@@ -106,7 +115,6 @@ class Bvh {
   std::string validate() const;
 
  private:
-  static constexpr uint32_t kNoLeaf = 0xffffffffu;
   bool occluded_below(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const;
 
   const Scene* scene_;

@@ -17,6 +17,7 @@ struct RayShear {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
 
+  RayShear() = default;
   explicit RayShear(const Ray& r) : org(r.org) {
     kz = max_dimension(abs(r.dir));
     kx = kz == 2 ? 0 : kz + 1;

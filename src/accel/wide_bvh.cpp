@@ -6,10 +6,12 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
 #include "accel/wide_bvh.hpp"
+#include "accel/ray_bundle-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -19,6 +21,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 // Per-ray constants of the slab test: the same arithmetic as the scalar RayBoxTest, so a child
 // is kept exactly when the binary tree would keep it (NaN from 0*inf never culls).
 struct WideRay {
+  WideRay() = default;
   float ox, oy, oz, ix, iy, iz, fx, fy, fz;  // origin, reciprocal direction, and the latter times kFarGuard
   bool nx, ny, nz;
   explicit WideRay(const Ray& r) : ox(r.org.x), oy(r.org.y), oz(r.org.z) {
@@ -246,23 +249,21 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   }
 }
 
-bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
-  const auto& nodes = bvh.nodes();
-  if (nodes.empty()) return false;
-  const WideRay wr(ray);
-  const RayShear shear(ray);
+// Any hit for one ray below `start` (a node, or a leaf pack when start.count > 0).
+HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar, StackEntry start) {
+  const WideNode* nodes = bvh.nodes().data();
   const Triangle* tris = bvh.triangles().data();
   const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
   HWY_ALIGN float t[kWideWidth];
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
-  StackEntry cur{0, 0, ray.tnear};
+  StackEntry cur = start;
   for (;;) {
     if (cur.count == 0) {
       // Any hit ends the query, so the children need no order: push them as found.
       const WideNode& n = nodes[cur.child];
-      uint32_t bits = TestChildren(n, wr, ray.tnear, ray.tfar, t);
+      uint32_t bits = TestChildren(n, wr, tnear, tfar, t);
       if (bits) {
         int c = __builtin_ctz(bits);
         for (bits &= bits - 1; bits; bits &= bits - 1) {
@@ -272,12 +273,129 @@ bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
         cur = {n.child[c], n.count[c], 0.0f};
         continue;
       }
-    } else if (IntersectPack(packs[cur.child], shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) {
+    } else if (IntersectPack(packs[cur.child], shear, tris, tnear, tfar, tt, uu, vv)) {
       return true;
     }
     if (sp == 0) return false;
     cur = stack[--sp];
   }
+}
+
+bool OccludedWide(const WideBvh& bvh, const Ray& ray) {
+  if (bvh.nodes().empty()) return false;
+  return OccludedBelow(bvh, WideRay(ray), RayShear(ray), ray.tnear, ray.tfar, StackEntry{0, 0, ray.tnear});
+}
+
+// Lane k of a bundle as a WideRay (the same values WideRay(rays.ray(k)) computes).
+HWY_INLINE WideRay LaneRay(const BundleState& st, int k) {
+  WideRay r;
+  r.ox = st.org[0];
+  r.oy = st.org[1];
+  r.oz = st.org[2];
+  r.ix = st.ix[k];
+  r.iy = st.iy[k];
+  r.iz = st.iz[k];
+  r.fx = st.fx[k];
+  r.fy = st.fy[k];
+  r.fz = st.fz[k];
+  r.nx = st.nx[k] != 0;
+  r.ny = st.ny[k] != 0;
+  r.nz = st.nz[k] != 0;
+  return r;
+}
+
+// Fewer rays than this entering a subtree together go down it one by one: a lane-parallel test
+// costs the same for one ray as for sixteen, a ray alone tests all eight children in one pass.
+constexpr int kBundleMinLanes = 8;
+
+// The lanes of `mask` whose rays hit a triangle of `pack`.
+HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t count, const Triangle* tris, const BundleState& st,
+                                         uint32_t mask) {
+  uint32_t found = 0;
+  for (uint32_t k = 0; k < count && mask; ++k) {
+    const Vec3 v0{pack.v[0][0][k], pack.v[0][1][k], pack.v[0][2][k]};
+    const Vec3 v1{pack.v[1][0][k], pack.v[1][1][k], pack.v[1][2][k]};
+    const Vec3 v2{pack.v[2][0][k], pack.v[2][1][k], pack.v[2][2][k]};
+    const uint32_t hit = OccludedByTriangle(v0, v1, v2, tris[pack.slot[k]], st, mask);
+    found |= hit;
+    mask &= ~hit;
+  }
+  return found;
+}
+
+uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t origin) {
+  const auto& nodes = bvh.nodes();
+  if (nodes.empty() || rays.active == 0) return 0;
+  const auto& leaves = bvh.leaf_places();
+  if (origin >= leaves.size() || leaves[origin] == WideBvh::kNoPlace) {
+    uint32_t occluded = 0;  // no leaf to start from: each ray from the root
+    for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      if (OccludedWide(bvh, rays.ray(k))) occluded |= 1u << k;
+    }
+    return occluded;
+  }
+  const BundleState st(rays);
+  // Rays that miss the tree's box are answered at once, as from the root.
+  const float lo[3] = {bvh.bounds().lo.x, bvh.bounds().lo.y, bvh.bounds().lo.z};
+  const float hi[3] = {bvh.bounds().hi.x, bvh.bounds().hi.y, bvh.bounds().hi.z};
+  uint32_t active = TestBundleBox(lo, hi, st, rays.active);
+  if (active == 0) return 0;
+  const Triangle* tris = bvh.triangles().data();
+  const TrianglePack* packs = bvh.packs().data();
+  uint32_t occluded = 0;
+
+  // Subtrees to search, each with the lanes that enter it: many lanes go on together, one SIMD
+  // lane per ray; a few go on one ray at a time.
+  struct Entry {
+    uint32_t child, count, lanes;
+  };
+  Entry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  const auto push_children = [&](const WideNode& n, uint32_t skip, uint32_t lanes) {
+    for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
+      if (c == skip || (n.child[c] == 0 && n.count[c] == 0)) continue;  // the way we came, or an empty slot
+      const float clo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, chi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
+      const uint32_t entering = TestBundleBox(clo, chi, st, lanes);
+      if (entering) stack[sp++] = {n.child[c], n.count[c], entering};
+    }
+  };
+  const auto search = [&] {
+    while (sp > 0) {
+      const Entry e = stack[--sp];
+      const uint32_t lanes = e.lanes & active;
+      if (lanes == 0) continue;
+      uint32_t found = 0;
+      if (std::popcount(lanes) < kBundleMinLanes) {
+        for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+          const int k = __builtin_ctz(bits);
+          if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f})) found |= 1u << k;
+        }
+      } else if (e.count > 0) {
+        found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
+      } else {
+        push_children(nodes[e.child], kWideWidth, lanes);
+      }
+      occluded |= found;
+      active &= ~found;
+      if (active == 0) return;
+    }
+  };
+  // The origin's leaf, then each ancestor's other children on the way up: every node off that
+  // path lies below exactly one of them, so together they cover the tree.
+  uint32_t where = leaves[origin];
+  uint32_t node = where / kWideWidth, slot = where % kWideWidth;
+  stack[sp++] = {nodes[node].child[slot], nodes[node].count[slot], active};
+  search();
+  while (active != 0) {
+    push_children(nodes[node], slot, active);
+    search();
+    where = bvh.node_places()[node];
+    if (where == WideBvh::kNoPlace) break;
+    node = where / kWideWidth;
+    slot = where % kWideWidth;
+  }
+  return occluded;
 }
 
 // Brute force over packs: closest hit, ties to the lower scene index as everywhere.
@@ -312,6 +430,7 @@ namespace tracer {
 
 HWY_EXPORT(IntersectWide);
 HWY_EXPORT(OccludedWide);
+HWY_EXPORT(OccludedBundleWide);
 HWY_EXPORT(CurrentTarget);
 HWY_EXPORT(IntersectBrute);
 HWY_EXPORT(OccludedBrute);
@@ -349,6 +468,9 @@ TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t fi
 // inline the whole traversal.
 bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectWide)(*this, ray, hit); }
 bool WideBvh::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedWide)(*this, ray); }
+uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t origin) const {
+  return HWY_DYNAMIC_DISPATCH(OccludedBundleWide)(*this, rays, origin);
+}
 
 std::string WideBvh::simd_target() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CurrentTarget)()); }
 
@@ -465,6 +587,21 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_
   if (binary.nodes().empty()) return;
   nodes_.reserve(binary.nodes().size() / 4 + 1);
   Collapser(binary, nodes_, packs_).collapse(0);
+  bounds_ = Aabb{binary.nodes()[0].lo, binary.nodes()[0].hi};
+  // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
+  node_place_.assign(nodes_.size(), kNoPlace);
+  leaf_place_.assign(scene.size(), kNoPlace);
+  for (uint32_t w = 0; w < nodes_.size(); ++w) {
+    const WideNode& n = nodes_[w];
+    for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
+      if (n.count[c] > 0) {
+        const TrianglePack& pack = packs_[n.child[c]];
+        for (uint32_t lane = 0; lane < n.count[c]; ++lane) leaf_place_[ids_[pack.slot[lane]]] = place(w, c);
+      } else if (n.child[c] != 0) {  // child 0 is the root: an empty slot
+        node_place_[n.child[c]] = place(w, c);
+      }
+    }
+  }
 }
 
 std::string WideBvh::validate() const {
@@ -474,7 +611,7 @@ std::string WideBvh::validate() const {
   std::vector<uint32_t> stack{0};
   // Every triangle below a child must lie in that child's box; check leaf by leaf.
   struct Pending { uint32_t node; Aabb box; };
-  std::vector<Pending> work{{0, Aabb{{-kInfinity, -kInfinity, -kInfinity}, {kInfinity, kInfinity, kInfinity}}}};
+  std::vector<Pending> work{{0, bounds_}};  // the root's children lie in the tree's bounds
   while (!work.empty()) {
     const Pending p = work.back();
     work.pop_back();
@@ -501,9 +638,15 @@ std::string WideBvh::validate() const {
           const Triangle& t = tris_[k];
           if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
           if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
+          if (leaf_place_.size() != seen.size() || leaf_place_[ids_[k]] != place(p.node, uint32_t(i))) {
+            return "leaf place of triangle " + std::to_string(ids_[k]) + " is wrong";
+          }
           ++seen[ids_[k]];
         }
       } else {
+        if (n.child[i] >= node_place_.size() || node_place_[n.child[i]] != place(p.node, uint32_t(i))) {
+          return "node " + std::to_string(n.child[i]) + " does not record its parent";
+        }
         work.push_back({n.child[i], box});
       }
     }
@@ -514,6 +657,10 @@ std::string WideBvh::validate() const {
   }
   for (size_t i = 0; i < visits.size(); ++i) {
     if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
+  }
+  if (node_place_.empty() || node_place_[0] != kNoPlace) return "the root has a parent";
+  for (size_t i = 0; i < seen.size(); ++i) {
+    if (seen[i] == 0 && leaf_place_[i] != kNoPlace) return "degenerate triangle " + std::to_string(i) + " has a leaf place";
   }
   return "";
 }

@@ -44,14 +44,26 @@ class WideBvh {
   // Closest hits of the packet's active lanes, traversed together; hits[k] is exactly what
   // intersect(rays.ray(k), hits[k]) gives. Inactive lanes' hits are left untouched.
   void intersect_packet(const RayPacket& rays, Hit* hits) const;
+  // The lanes of rays.active whose rays, leaving scene triangle `origin` from one point (the AO
+  // rays of one shading point), are occluded; each the answer occluded() gives its ray. The
+  // search starts at the origin's leaf and walks up: at each level the ancestor's other children
+  // are tested against all the rays at once (one SIMD lane per ray), then entered ray by ray.
+  uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const std::vector<TrianglePack>& packs() const { return packs_; }
   const TriangleArray& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }
+  // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kNoPlace.
+  const std::vector<uint32_t>& node_places() const { return node_place_; }
+  // The node and slot of the leaf holding each scene triangle (kNoPlace: degenerate, in no leaf).
+  const std::vector<uint32_t>& leaf_places() const { return leaf_place_; }
+  static constexpr uint32_t kNoPlace = 0xffffffffu;
+  static constexpr uint32_t place(uint32_t node, uint32_t slot) { return node * kWideWidth + slot; }
+  const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const {
     return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) +
-           ids_.size() * sizeof(uint32_t);
+           (ids_.size() + node_place_.size() + leaf_place_.size()) * sizeof(uint32_t);
   }
   // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf.
   std::string validate() const;
@@ -69,6 +81,8 @@ class WideBvh {
   std::vector<TrianglePack> packs_;
   TriangleArray tris_;
   std::vector<uint32_t> ids_;
+  std::vector<uint32_t> node_place_, leaf_place_;
+  Aabb bounds_;
 };
 
 // The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight

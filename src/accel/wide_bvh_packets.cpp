@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "accel/wide_bvh.hpp"
+#include "accel/lane_bits-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -39,20 +40,6 @@ struct PacketState {
 
 constexpr int32_t kFlip = INT32_MIN;
 
-// Lane bits of `m` for the lanes [first, first + Lanes(d)).
-template <class D>
-HWY_INLINE uint32_t Bits(D d, hn::Mask<D> m) {
-  uint8_t bytes[8] = {0};
-  hn::StoreMaskBits(d, m, bytes);
-  return uint32_t(bytes[0]) | uint32_t(bytes[1]) << 8;
-}
-
-template <class D>
-HWY_INLINE hn::Mask<D> LaneMask(D d, uint32_t bits) {
-  const uint8_t bytes[8] = {uint8_t(bits), uint8_t(bits >> 8), 0, 0, 0, 0, 0, 0};
-  return hn::LoadMaskBits(d, bytes);
-}
-
 // Tests child `c` of `n` against the lanes in `mask`: returns the lanes that enter it before
 // their closest hit, and the entry distance of the first of them (the visiting order: in a
 // coherent packet one ray's order is the packet's, and it costs no reduction across lanes).
@@ -66,7 +53,7 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
   HWY_ALIGN float t0s[kPacketSize];
   uint32_t hits = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
-    const uint32_t chunk = (mask >> i) & ((N >= 32 ? 0u : (1u << N)) - 1u);
+    const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
     const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nx + i), hn::Zero(di)));
     const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
@@ -111,7 +98,7 @@ HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Tria
   const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
   const auto vid = hn::Set(di, id);
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
-    const uint32_t chunk = (mask >> i) & ((N >= 32 ? 0u : (1u << N)) - 1u);
+    const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
     const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
     const auto sx = hn::Load(d, st.sx + i), sy = hn::Load(d, st.sy + i), sz = hn::Load(d, st.sz + i);

@@ -40,7 +40,7 @@ struct Variant {
   SchedKind sched;
   std::string description;
   bool study;
-  bool packets = false;  // primary rays in 4x4 packets (bvh8)
+  bool packets = false;  // primary rays in 4x4 packets (bvh8), AO rays in bundles (bvh, bvh8)
 };
 
 // The study's ten columns (its ISPC column waits for the SIMD kernels) and ours.
@@ -62,7 +62,7 @@ const std::vector<Variant>& all_variants() {
       {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic, "SAH BVH (TBB build), atomic tile counter", false},
       {"tbb+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
       {"bvh8", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), TBB work stealing", false},
-      {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), primary-ray packets, TBB work stealing", false, true},
+      {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), primary-ray packets and AO bundles, TBB work stealing", false, true},
       {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "Intel Embree 3, TBB work stealing", false},
   };
   return v;

@@ -79,7 +79,7 @@ int cmd_render(const RenderArgs& args) {
     std::printf("scene        %s (%zu triangles)\n", scene.source.c_str(), scene.size());
     std::printf("image        %dx%d, %d AO rays per hit -> %s\n", settings.width, settings.height, settings.ao_samples, args.output.c_str());
     std::printf("accelerator  %s, %.1f bytes/triangle%s\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()),
-                settings.packets ? ", primary rays in 4x4 packets" : "");
+                !settings.packets ? "" : std::holds_alternative<WideBvh>(*accel.impl) ? ", primary rays in 4x4 packets, AO rays in bundles" : ", AO rays in bundles");
     if (const auto* bvh = std::get_if<Bvh>(accel.impl.get())) {
       const BvhStats st = bvh->stats();
       std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st.nodes, st.leaves,

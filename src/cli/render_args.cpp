@@ -38,7 +38,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
       ->capture_default_str();
   app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")->capture_default_str();
   app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
-  app.add_flag("--packets", a.packets, "trace primary rays in 4x4-pixel packets (--accel bvh8); same image");
+  app.add_flag("--packets", a.packets, "trace rays together: each hit's AO rays as one bundle (bvh, bvh8), primary rays in 4x4-pixel packets (bvh8); same image");
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
@@ -77,7 +77,9 @@ void validate(const RenderArgs& a) {
   }
   for (const auto& l : a.scene.lights) parse_vec3("--light", l);
   const AccelOptions accel = accel_options_for(a);
-  if (a.packets && accel.kind != AccelKind::Bvh8) throw UsageError("--packets: needs --accel bvh8 (the packet kernels run on the 8-wide BVH)");
+  if (a.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh) {
+    throw UsageError("--packets: needs --accel bvh or bvh8 (the accelerators with packet kernels)");
+  }
   parse_sched(a.sched);
   if (!WideBvh::force_simd_target(lower(a.simd_target))) {
     throw UsageError("--simd-target: unknown target '" + a.simd_target + "' (auto, avx512, avx2, sse4)");

@@ -39,4 +39,28 @@ struct alignas(64) RayPacket {
   }
 };
 
+// Up to 16 rays that share their origin and interval but not their direction: the ambient-
+// occlusion rays of one shading point. Directions in structure-of-arrays form, one lane per ray.
+struct alignas(64) RayBundle {
+  float dx[kPacketSize]{}, dy[kPacketSize]{}, dz[kPacketSize]{};  // zeros in lanes without a ray
+  Vec3 org;
+  float tnear = 0.0f, tfar = kInfinity;
+  uint32_t active = 0;  // bit k: lane k holds a ray
+
+  void set_direction(int lane, Vec3 d) {
+    dx[lane] = d.x;
+    dy[lane] = d.y;
+    dz[lane] = d.z;
+    active |= 1u << lane;
+  }
+  Ray ray(int lane) const {
+    Ray r;
+    r.org = org;
+    r.dir = {dx[lane], dy[lane], dz[lane]};
+    r.tnear = tnear;
+    r.tfar = tfar;
+    return r;
+  }
+};
+
 }  // namespace tracer

@@ -3,7 +3,9 @@
 // ambient-occlusion rays. Templated on the accelerator so the per-ray path has no virtual call.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -79,6 +81,10 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
 template <class A>
 concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) { a.intersect_packet(p, h); };
 
+// Accelerators that answer the AO rays of one shading point as one bundle (the binary BVH).
+template <class A>
+concept BundleAccelerator = requires(const A& a, const RayBundle& b) { a.occluded_bundle_from(b, 0u); };
+
 // An occlusion query for a ray leaving scene triangle `origin`: accelerators that can start the
 // search at that triangle's leaf (the binary BVH) do; the others search from the root.
 template <class Accel>
@@ -132,14 +138,34 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
   float unoccluded = 1.0f;
   if (s.ao_samples > 0) {
     const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
-    int open = 0;
-    for (int i = 0; i < s.ao_samples; ++i) {
+    const auto direction = [&](int i) {
       const SampleRng rng(pixel, uint32_t(i), s.seed);
-      Ray ao;
-      ao.org = origin;
-      ao.dir = ao_direction(n, rng.draw(0), rng.draw(1));
-      ao.tfar = s.ao_distance;
-      open += occluded_leaving(accel, ao, hit.tri) ? 0 : 1;
+      return ao_direction(n, rng.draw(0), rng.draw(1));
+    };
+    int open = 0;
+    bool bundled = false;
+    if constexpr (BundleAccelerator<Accel>) {
+      if (s.packets) {
+        // Up to 16 rays at a time; each gets the answer it gets alone, so the image is the same.
+        for (int first = 0; first < s.ao_samples; first += kPacketSize) {
+          RayBundle bundle;
+          bundle.org = origin;
+          bundle.tfar = s.ao_distance;
+          const int count = std::min(kPacketSize, s.ao_samples - first);
+          for (int k = 0; k < count; ++k) bundle.set_direction(k, direction(first + k));
+          open += count - std::popcount(accel.occluded_bundle_from(bundle, hit.tri));
+        }
+        bundled = true;
+      }
+    }
+    if (!bundled) {
+      for (int i = 0; i < s.ao_samples; ++i) {
+        Ray ao;
+        ao.org = origin;
+        ao.dir = direction(i);
+        ao.tfar = s.ao_distance;
+        open += occluded_leaving(accel, ao, hit.tri) ? 0 : 1;
+      }
     }
     counts.ao += uint64_t(s.ao_samples);
     unoccluded = float(open) / float(s.ao_samples);
