@@ -3,6 +3,7 @@
 // the renderer really traces. Run: build/release/bench/tracer_microbench [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
+#include <bit>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -46,6 +47,28 @@ struct SceneCase {
   RecordedRays rays;
 };
 
+// The recorded AO rays as the renderer bundles them: each hit's rays (same origin, consecutive).
+struct AoBundle {
+  RayBundle rays;
+  uint32_t origin;
+};
+
+std::vector<AoBundle> ao_bundles(const RecordedRays& r) {
+  std::vector<AoBundle> out;
+  for (size_t i = 0; i < r.ao.size();) {
+    AoBundle b;
+    b.rays.org = r.ao[i].org;
+    b.rays.tnear = r.ao[i].tnear;
+    b.rays.tfar = r.ao[i].tfar;
+    b.origin = r.ao_from[i];
+    for (int k = 0; k < kPacketSize && i < r.ao.size() && r.ao[i].org == b.rays.org && r.ao_from[i] == b.origin; ++k, ++i) {
+      b.rays.set_direction(k, r.ao[i].dir);
+    }
+    out.push_back(b);
+  }
+  return out;
+}
+
 std::vector<SceneCase>& cases() {
   static std::vector<SceneCase> all = [] {
     std::vector<SceneCase> v;
@@ -54,9 +77,11 @@ std::vector<SceneCase>& cases() {
       c.name = name;
       c.scene = std::make_shared<Scene>(std::move(s));
       c.bvh = std::make_shared<Bvh>(*c.scene, BvhBuildOptions{});
+      // 16 AO rays per hit, as the renderer's default: each hit's AO rays are recorded one after
+      // the other, so they can also be traced as the renderer's bundles.
       RenderSettings rs;
-      rs.width = rs.height = 128;
-      rs.ao_samples = 4;
+      rs.width = rs.height = 64;
+      rs.ao_samples = 16;
       Framebuffer fb(rs.width, rs.height);
       const CameraSpec cam = c.scene->camera ? *c.scene->camera : frame_bounds(c.scene->bounds);
       RenderContext ctx{c.scene.get(), Camera(cam, rs.width, rs.height), rs, &fb};
@@ -197,19 +222,28 @@ void register_dynamic() {
     for (const auto& [accel_name, options] : accels) {
       auto accel = std::make_shared<Accelerator>(build_accelerator(*c.scene, options));
       // Shadow and AO rays go through occluded_leaving(), as in the renderer: the binary BVH starts
-      // them at their origin triangle's leaf. "ao-from-root" is the same AO rays from the root.
-      for (int kind = 0; kind < 4; ++kind) {
-        static const char* kinds[] = {"primary", "shadow", "ao", "ao-from-root"};
+      // them at their origin triangle's leaf. "ao-from-root" is the same AO rays from the root;
+      // "ao-bundles" the same AO rays in the renderer's bundles (--packets), 16 per hit.
+      for (int kind = 0; kind < 5; ++kind) {
+        static const char* kinds[] = {"primary", "shadow", "ao", "ao-from-root", "ao-bundles"};
         if (kind == 3 && options.kind != AccelKind::Bvh) continue;
+        if (kind == 4 && options.kind != AccelKind::Bvh && options.kind != AccelKind::Bvh8) continue;
         const std::vector<Ray>* rays = kind == 0 ? &c.rays.primary : (kind == 1 ? &c.rays.shadow : &c.rays.ao);
         const std::vector<uint32_t>* from = kind == 1 ? &c.rays.shadow_from : &c.rays.ao_from;
         if (rays->empty()) continue;
         const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind];
-        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, from, kind](benchmark::State& st) {
+        auto bundles = std::make_shared<std::vector<AoBundle>>(kind == 4 ? ao_bundles(c.rays) : std::vector<AoBundle>{});
+        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, from, kind, bundles](benchmark::State& st) {
           size_t n = 0;
           accel->visit([&](const auto& a) {
             Hit h;
             for (auto _ : st) {
+              if constexpr (BundleAccelerator<std::decay_t<decltype(a)>>) {
+                if (kind == 4) {
+                  for (const AoBundle& b : *bundles) n += size_t(std::popcount(a.occluded_bundle_from(b.rays, b.origin)));
+                  continue;
+                }
+              }
               if (kind == 0) {
                 for (const Ray& r : *rays) n += a.intersect(r, h);
               } else if (kind == 3) {

@@ -91,6 +91,10 @@ inline bool Bvh::occluded_below(uint32_t node, const Ray& ray, const RayShear& s
   }
 }
 
+bool Bvh::occluded_subtree(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const {
+  return occluded_below(node, ray, shear, box);
+}
+
 bool Bvh::occluded(const Ray& ray) const {
   if (nodes_.empty()) return false;
   const RayShear shear(ray);

@@ -114,6 +114,10 @@ class Bvh {
   // Checks the tree's invariants; returns an empty string when they hold, else the first violation.
   std::string validate() const;
 
+  // Any hit below `node`, whose box the caller has found the ray entering (shear and box are
+  // the ray's own constants).
+  bool occluded_subtree(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const;
+
  private:
   bool occluded_below(uint32_t node, const Ray& ray, const RayShear& shear, const RayBoxTest& box) const;
 

@@ -13,6 +13,8 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include <bit>
+
 #include "accel/bvh.hpp"
 #include "accel/ray_bundle-inl.h"
 
@@ -27,9 +29,22 @@ HWY_INLINE uint32_t TestBox(const BvhNode& n, const BundleState& st, uint32_t ma
   return TestBundleBox(lo, hi, st, mask);
 }
 
-// The lanes of `mask` whose rays hit a triangle of leaf `n`.
+// Fewer rays than this entering a subtree together go down it one by one (the scalar
+// traversal): a lane-parallel test costs the same for one ray as for sixteen.
+constexpr int kBundleMinLanes = 4;
+
+// The lanes of `mask` whose rays hit a triangle of leaf `n`: triangle by triangle against all
+// the lanes at once when there are at least as many rays as triangles, else ray by ray.
 HWY_INLINE uint32_t OccludedInLeaf(const BvhNode& n, const Triangle* tris, const BundleState& st, uint32_t mask) {
   uint32_t found = 0;
+  if (std::popcount(mask) >= int(n.count)) {
+    for (uint32_t i = n.index, end = n.index + n.count; i < end && mask; ++i) {
+      const uint32_t hit = OccludedByTriangle(tris[i].v0, tris[i].v1, tris[i].v2, tris[i], st, mask);
+      found |= hit;
+      mask &= ~hit;
+    }
+    return found;
+  }
   for (uint32_t bits = mask; bits; bits &= bits - 1) {
     const int lane = __builtin_ctz(bits);
     const RayShear shear = st.shear(lane);
@@ -45,7 +60,7 @@ HWY_INLINE uint32_t OccludedInLeaf(const BvhNode& n, const Triangle* tris, const
 }
 
 // The lanes of `mask`, all entering node `root`'s box, whose rays hit a triangle below it.
-HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, uint32_t root, const BundleState& st, uint32_t mask) {
+HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, const RayBundle& rays, uint32_t root, const BundleState& st, uint32_t mask) {
   const BvhNode* nodes = bvh.nodes().data();
   const Triangle* tris = bvh.triangles().data();
   struct Entry {
@@ -59,6 +74,13 @@ HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, uint32_t root, const BundleSta
     const BvhNode& n = nodes[cur.node];
     if (n.leaf()) {
       found |= OccludedInLeaf(n, tris, st, cur.mask);
+      if (found == mask) return found;
+    } else if (std::popcount(cur.mask) < kBundleMinLanes) {
+      for (uint32_t bits = cur.mask; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        const Ray ray = rays.ray(k);
+        if (bvh.occluded_subtree(cur.node, ray, st.shear(k), RayBoxTest(ray))) found |= 1u << k;
+      }
       if (found == mask) return found;
     } else {
       const BvhNode& a = nodes[n.index];
@@ -93,10 +115,10 @@ uint32_t OccludedBundleFrom(const Bvh& bvh, const RayBundle& rays, uint32_t orig
   uint32_t active = TestBox(nodes[0], st, rays.active);
   if (active == 0) return 0;
   const auto& leaf_of = bvh.leaf_of();
-  if (origin >= leaf_of.size() || leaf_of[origin] == Bvh::kNoLeaf) return OccludedBelow(bvh, 0, st, active);
+  if (origin >= leaf_of.size() || leaf_of[origin] == Bvh::kNoLeaf) return OccludedBelow(bvh, rays, 0, st, active);
   // The leaf, then each level's sibling subtree on the way up: together they cover the tree.
   uint32_t node = leaf_of[origin];
-  uint32_t occluded = OccludedBelow(bvh, node, st, active);
+  uint32_t occluded = OccludedBelow(bvh, rays, node, st, active);
   active &= ~occluded;
   const auto& parents = bvh.pair_parents();
   while (node != 0 && active) {
@@ -104,7 +126,7 @@ uint32_t OccludedBundleFrom(const Bvh& bvh, const RayBundle& rays, uint32_t orig
     node = parents[node >> 1];
     const uint32_t entering = TestBox(nodes[sibling], st, active);
     if (entering == 0) continue;
-    const uint32_t found = OccludedBelow(bvh, sibling, st, entering);
+    const uint32_t found = OccludedBelow(bvh, rays, sibling, st, entering);
     occluded |= found;
     active &= ~found;
   }
