@@ -51,12 +51,12 @@ for t in 1 2; do
 done
 
 # 4. Microbenchmarks: build times per split/builder, Mrays/s per ray type, bytes per triangle.
-#    Traversal three times over: docs/BENCHMARKS.md quotes the best of the three for each row, as
+#    Traversal five times over: docs/BENCHMARKS.md quotes the best of the five for each row, as
 #    `tracer bench` keeps its best runs (this shared VM has bursts of slowdown).
 build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console \
   --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/microbench.txt"
-build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console --benchmark_repetitions=3 \
+build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console --benchmark_repetitions=5 \
   --benchmark_filter='BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Primary1024/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/traversal.txt"
 # Builds per scene, split and builder, five repetitions each (medians for section 4).
