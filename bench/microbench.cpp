@@ -2,7 +2,11 @@
 // and traversal throughput per ray type (primary, shadow, AO) for every accelerator, on the rays
 // the renderer really traces. Run: build/release/bench/tracer_microbench [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <atomic>
 #include <bit>
 #include <filesystem>
 #include <memory>
@@ -91,7 +95,8 @@ std::vector<SceneCase>& cases() {
     };
     add("builtin-spheres", make_cornell_box(20000));
     const std::string dir = TRACER_SCENES_DIR;
-    for (const auto& [name, path] : {std::pair{"Sphere", "/cornell-box/CornellBox-Sphere.obj"}, {"Water", "/cornell-box/CornellBox-Water.obj"},
+    for (const auto& [name, path] : {std::pair{"Original", "/cornell-box/CornellBox-Original.obj"}, {"Sphere", "/cornell-box/CornellBox-Sphere.obj"},
+                                     {"Water", "/cornell-box/CornellBox-Water.obj"},
                                      {"Sponza", "/sponza/sponza.obj"}, {"Sibenik", "/sibenik/sibenik.obj"}, {"Bunny", "/bunny/bunny.obj"}}) {
       if (std::filesystem::exists(dir + path)) add(name, load_obj(dir + path, [](const std::string&) {}));
     }
@@ -231,31 +236,49 @@ void register_dynamic() {
         const std::vector<Ray>* rays = kind == 0 ? &c.rays.primary : (kind == 1 ? &c.rays.shadow : &c.rays.ao);
         const std::vector<uint32_t>* from = kind == 1 ? &c.rays.shadow_from : &c.rays.ao_from;
         if (rays->empty()) continue;
-        const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind];
         auto bundles = std::make_shared<std::vector<AoBundle>>(kind == 4 ? ao_bundles(c.rays) : std::vector<AoBundle>{});
-        benchmark::RegisterBenchmark(name.c_str(), [accel, rays, from, kind, bundles](benchmark::State& st) {
+        // The rays (or bundles) [begin, end) through `a`, as the renderer asks for them.
+        const auto trace = [rays, from, kind, bundles](const auto& a, size_t begin, size_t end) {
           size_t n = 0;
-          accel->visit([&](const auto& a) {
-            Hit h;
-            for (auto _ : st) {
-              if constexpr (BundleAccelerator<std::decay_t<decltype(a)>>) {
-                if (kind == 4) {
-                  for (const AoBundle& b : *bundles) n += size_t(std::popcount(a.occluded_bundle_from(b.rays, b.origin)));
+          Hit h;
+          if constexpr (BundleAccelerator<std::decay_t<decltype(a)>>) {
+            if (kind == 4) {
+              for (size_t i = begin; i < end; ++i) n += size_t(std::popcount(a.occluded_bundle_from((*bundles)[i].rays, (*bundles)[i].origin)));
+              return n;
+            }
+          }
+          for (size_t i = begin; i < end; ++i) {
+            const Ray& r = (*rays)[i];
+            n += kind == 0 ? a.intersect(r, h) : kind == 3 ? a.occluded(r) : occluded_leaving(a, r, (*from)[i]);
+          }
+          return n;
+        };
+        const size_t items = kind == 4 ? bundles->size() : rays->size();
+        const double mrays = double(rays->size()) * 1e-6;
+        // One thread, and two (the same rays split in chunks over a two-thread oneTBB arena).
+        for (const int threads : {1, 2}) {
+          const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind] + (threads == 2 ? "/2threads" : "");
+          auto* b = benchmark::RegisterBenchmark(name.c_str(), [accel, trace, items, mrays, threads](benchmark::State& st) {
+            std::atomic<size_t> n{0};
+            tbb::task_arena arena(threads);
+            accel->visit([&](const auto& a) {
+              for (auto _ : st) {
+                if (threads == 1) {
+                  n += trace(a, 0, items);
                   continue;
                 }
+                arena.execute([&] {
+                  tbb::parallel_for(tbb::blocked_range<size_t>(0, items, 64),
+                                    [&](const tbb::blocked_range<size_t>& r) { n += trace(a, r.begin(), r.end()); });
+                });
               }
-              if (kind == 0) {
-                for (const Ray& r : *rays) n += a.intersect(r, h);
-              } else if (kind == 3) {
-                for (const Ray& r : *rays) n += a.occluded(r);
-              } else {
-                for (size_t i = 0; i < rays->size(); ++i) n += occluded_leaving(a, (*rays)[i], (*from)[i]);
-              }
-            }
+            });
+            benchmark::DoNotOptimize(n.load());
+            st.counters["Mrays/s"] = benchmark::Counter(mrays, benchmark::Counter::kIsIterationInvariantRate);
           });
-          benchmark::DoNotOptimize(n);
-          st.counters["Mrays/s"] = benchmark::Counter(double(rays->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-        })->Unit(benchmark::kMillisecond);
+          b->Unit(benchmark::kMillisecond);
+          if (threads == 2) b->UseRealTime();  // the main thread's CPU time would count only its half
+        }
       }
     }
   }

@@ -57,7 +57,7 @@ build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_forma
   --benchmark_filter='BM_TriangleTest|BM_BoxTest|BM_BvhBuild/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/microbench.txt"
 build/release/bench/tracer_microbench --benchmark_min_time=0.3 --benchmark_format=console --benchmark_repetitions=5 \
-  --benchmark_filter='BM_Traverse/(Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Primary1024/(Sphere|Water|Sponza|Sibenik|Bunny)/' \
+  --benchmark_filter='BM_Traverse/(Original|Sphere|Water|Sponza|Sibenik|Bunny)/|BM_Primary1024/(Original|Sphere|Water|Sponza|Sibenik|Bunny)/' \
   2>/dev/null | tee "$O/traversal.txt"
 # Builds per scene, split and builder, five repetitions each (medians for section 4).
 build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/(Sphere|Water|Sponza|Sibenik)/' \
