@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <random>
 
 #include "render/shading.hpp"
@@ -54,7 +55,8 @@ std::vector<Scene> agreement_scenes() {
   return scenes;
 }
 
-TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
+// Runs `check` on every agreement scene with every SIMD target this CPU has, forced one by one.
+void for_each_target_and_scene(const std::function<void(const Scene&)>& check) {
   TargetGuard guard;
   const std::vector<Scene> scenes = agreement_scenes();
   for (const std::string& target : targets()) {
@@ -62,9 +64,15 @@ TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
     SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
     for (const Scene& scene : scenes) {
       SCOPED_TRACE(scene.source);
-      EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 77)), 0u);
+      check(scene);
     }
   }
+}
+
+TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
+  for_each_target_and_scene([](const Scene& scene) {
+    EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 77)), 0u);
+  });
 }
 
 TEST(WideBvh, RaysStartingOnTrianglesAndAlongEdges) {
@@ -220,23 +228,16 @@ std::vector<Ray> primary_rays_in_packet_order(const Scene& scene, int width, int
 }
 
 TEST(RayPackets, SameHitsAsSingleRaysOnEveryTarget) {
-  TargetGuard guard;
-  const std::vector<Scene> scenes = agreement_scenes();
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
-    for (const Scene& scene : scenes) {
-      SCOPED_TRACE(scene.source);
-      const WideBvh wide(scene, BvhBuildOptions{});
-      // Coherent: every primary ray of a 61x47 render (partial packets at the right and bottom).
-      EXPECT_EQ(packet_disagreements(wide, primary_rays_in_packet_order(scene, 61, 47)), 0u);
-      // Incoherent: random rays, mostly packets whose rays do not share shear axes.
-      const std::vector<Ray> random = test::random_rays(scene, test::ray_budget(20'000) / 4, 5);
-      EXPECT_EQ(packet_disagreements(wide, random), 0u);
-      // Sparse packets: only some lanes active.
-      EXPECT_EQ(packet_disagreements(wide, primary_rays_in_packet_order(scene, 24, 24), 0x8421u), 0u);
-    }
-  }
+  for_each_target_and_scene([](const Scene& scene) {
+    const WideBvh wide(scene, BvhBuildOptions{});
+    // Coherent: every primary ray of a 61x47 render (partial packets at the right and bottom).
+    EXPECT_EQ(packet_disagreements(wide, primary_rays_in_packet_order(scene, 61, 47)), 0u);
+    // Incoherent: random rays, mostly packets whose rays do not share shear axes.
+    const std::vector<Ray> random = test::random_rays(scene, test::ray_budget(20'000) / 4, 5);
+    EXPECT_EQ(packet_disagreements(wide, random), 0u);
+    // Sparse packets: only some lanes active.
+    EXPECT_EQ(packet_disagreements(wide, primary_rays_in_packet_order(scene, 24, 24), 0x8421u), 0u);
+  });
 }
 
 TEST(RayPackets, RaysThroughVerticesAndEdges) {
@@ -326,20 +327,13 @@ size_t bundle_disagreements(const A& accel, const std::vector<BundleCase>& cases
 }
 
 TEST(RayBundles, SameAnswersAsSingleRaysOnEveryTarget) {
-  TargetGuard guard;
-  const std::vector<Scene> scenes = agreement_scenes();
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
-    for (const Scene& scene : scenes) {
-      SCOPED_TRACE(scene.source);
-      const std::vector<BundleCase> cases = bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 17);
-      const Bvh binary(scene, BvhBuildOptions{});
-      EXPECT_EQ(bundle_disagreements(binary, cases), 0u) << "bvh";
-      const WideBvh wide(scene, BvhBuildOptions{});
-      EXPECT_EQ(bundle_disagreements(wide, cases), 0u) << "bvh8";
-    }
-  }
+  for_each_target_and_scene([](const Scene& scene) {
+    const std::vector<BundleCase> cases = bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 17);
+    const Bvh binary(scene, BvhBuildOptions{});
+    EXPECT_EQ(bundle_disagreements(binary, cases), 0u) << "bvh";
+    const WideBvh wide(scene, BvhBuildOptions{});
+    EXPECT_EQ(bundle_disagreements(wide, cases), 0u) << "bvh8";
+  });
 }
 
 TEST(RayBundles, RaysThroughVerticesAndEdges) {
