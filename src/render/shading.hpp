@@ -81,7 +81,7 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
 template <class A>
 concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) { a.intersect_packet(p, h); };
 
-// Accelerators that answer the AO rays of one shading point as one bundle (the binary BVH).
+// Accelerators that answer the AO rays of one shading point as one bundle (both BVHs).
 template <class A>
 concept BundleAccelerator = requires(const A& a, const RayBundle& b) { a.occluded_bundle_from(b, 0u); };
 
