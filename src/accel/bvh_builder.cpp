@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <memory>
 #include <thread>
+#include <utility>
 
 #include <immintrin.h>  // SSE2, part of every x86-64
 
@@ -149,7 +150,7 @@ class BvhBuilder {
     node_count_ = 1;
     const int threads = resolve_thread_count(options_.threads);
     switch (options_.mode) {
-      case BuildMode::Seq: build_seq(0); break;
+      case BuildMode::Seq: build_subtree(0); break;
       case BuildMode::Async: build_async(0, async_depth_limit(threads)); break;
       case BuildMode::Queue: build_queue(threads); break;
       case BuildMode::Tasks: {
@@ -166,11 +167,11 @@ class BvhBuilder {
   // `pair_parent` receives each sibling pair's parent, `leaf_of` each scene triangle's leaf.
   void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent, std::vector<uint32_t>& leaf_of) {
     ids.resize(count_);
-    out.resize(count_ == 0 ? 0 : node_count_.load() + 1);  // + the padding node
+    // subtree_size() also fills in the sizes the queue build left unknown at the top.
+    out.resize(count_ == 0 ? 0 : subtree_size(0) + 1);  // + the padding node
     pair_parent.assign((out.size() + 1) / 2, 0);
     if (count_ == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
-    subtree_size(0);                 // fills in sizes the queue build left unknown at the top
     publish();
     const Output o{out.data(), ids.data(), pair_parent.data(), leaf_of.data()};
     place(o, 0, 0, 2, options_.mode == BuildMode::Tasks);
@@ -183,11 +184,20 @@ class BvhBuilder {
     return std::bit_width(static_cast<unsigned>(threads)) + 1;
   }
 
-  void build_seq(uint32_t id) {
-    if (split(id, false)) {
+  // Builds everything below `id` on this thread. The descendants' build nodes go to one block
+  // reserved up front (n primitives make at most 2n - 2 of them), so threads building different
+  // subtrees never write neighbouring nodes (no false sharing) and take no atomic per node.
+  void build_subtree(uint32_t id) {
+    const BuildNode& n = nodes_[id];
+    uint32_t cursor = n.end - n.begin > 1 ? node_count_.fetch_add(2 * (n.end - n.begin) - 2, std::memory_order_relaxed) : 0;
+    build_seq(id, cursor);
+  }
+
+  void build_seq(uint32_t id, uint32_t& cursor) {
+    if (split(id, false, &cursor)) {
       const uint32_t left = nodes_[id].left;
-      build_seq(left);
-      build_seq(left + 1);
+      build_seq(left, cursor);
+      build_seq(left + 1, cursor);
     }
     finish(id);
   }
@@ -203,8 +213,8 @@ class BvhBuilder {
       build_async(left, depth_left - 1);
       right.get();
     } else {
-      build_seq(left);
-      build_seq(left + 1);
+      build_subtree(left);
+      build_subtree(left + 1);
     }
     finish(id);
   }
@@ -228,7 +238,7 @@ class BvhBuilder {
         }
         const BuildNode& n = nodes_[id];
         if (n.end - n.begin < kParallelSubtree) {
-          build_seq(id);
+          build_subtree(id);
         } else if (split(id, false)) {
           const uint32_t left = nodes_[id].left;
           std::lock_guard lock(mutex);
@@ -252,7 +262,7 @@ class BvhBuilder {
     const BuildNode& n = nodes_[id];
     const uint32_t size = n.end - n.begin;
     if (size < kParallelSubtree) {
-      build_seq(id);
+      build_subtree(id);
       return;
     }
     if (!split(id, size >= kParallelSplit)) return finish(id);
@@ -341,8 +351,9 @@ class BvhBuilder {
     return result;
   }
 
-  // Decides node `id`: a leaf (false) or two children appended to nodes_ (true).
-  bool split(uint32_t id, bool parallel) {
+  // Decides node `id`: a leaf (false) or two children (true), placed at *cursor (which advances)
+  // or, without one, wherever the shared node counter says.
+  bool split(uint32_t id, bool parallel, uint32_t* cursor = nullptr) {
     BuildNode& node = nodes_[id];
     const uint32_t begin = node.begin, end = node.end, count = end - begin;
     PrimRef* refs = buffers_[node.buffer].get();
@@ -391,7 +402,7 @@ class BvhBuilder {
         }
       }
     }
-    const uint32_t left = node_count_.fetch_add(2, std::memory_order_relaxed);
+    const uint32_t left = cursor ? std::exchange(*cursor, *cursor + 2) : node_count_.fetch_add(2, std::memory_order_relaxed);
     nodes_[left] = BuildNode{{}, begin, mid, kNone, node.depth + 1};
     nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
     if (children_known) {
@@ -536,10 +547,11 @@ class BvhBuilder {
     } else {
       fill(node.begin, node.end, bins);
     }
-    SahChoice best;
-    best.cost = kInfinity;
-    const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
-    const float traversal_cost = options_.traversal_cost, intersection_cost = options_.intersection_cost;
+    // The sweep compares the split's raw area-count sum and keeps the best in scalars, selected
+    // without a branch (which bin wins is unpredictable); the cost is formed once, at the end.
+    int best_axis = -1, best_bin = 0;
+    uint32_t best_left = 0;
+    float best_raw = kInfinity;
     for (int a = 0; a < 3; ++a) {
       if (cbox.hi[a] <= cbox.lo[a]) continue;
       float right_cost[kMaxBins];  // area * count of bins [s, nb)
@@ -552,12 +564,21 @@ class BvhBuilder {
       acc.reset();
       for (int s = 1; s < nb; ++s) {
         acc.add(bins.bins[a][s - 1]);
-        if (acc.count == 0) continue;
-        const float cost = traversal_cost + intersection_cost * (acc.half_area() * float(acc.count) + right_cost[s]) * inv_area;
-        if (cost < best.cost) best = {a, s, cost, nb, acc.count};
+        const float raw = acc.count ? acc.half_area() * float(acc.count) + right_cost[s] : kInfinity;
+        const bool better = raw < best_raw;
+        best_raw = better ? raw : best_raw;
+        best_axis = better ? a : best_axis;
+        best_bin = better ? s : best_bin;
+        best_left = better ? acc.count : best_left;
       }
     }
-    if (!(best.cost < kInfinity)) {
+    const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
+    SahChoice best;
+    best.axis = best_axis;
+    best.split_bin = best_bin;
+    best.left_count = best_left;
+    best.cost = options_.traversal_cost + options_.intersection_cost * best_raw * inv_area;
+    if (!(best_raw < kInfinity)) {
       best.axis = -1;
     } else {
       RawBin l, r;
