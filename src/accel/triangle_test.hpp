@@ -4,6 +4,7 @@
 // vertex hits at least one of the triangles around it. Two-sided.
 #pragma once
 
+#include <type_traits>
 #include <utility>
 
 #include "math/ray.hpp"
@@ -36,30 +37,36 @@ struct TriangleHit {
 
 // Hit if t lies in [tnear, tfar]; inclusive at both ends so callers can break ties on t themselves.
 inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tnear, float tfar, TriangleHit& out) {
-  // Vertices relative to the origin, as arrays so the permuted axes are plain indexed loads.
-  const float a[3] = {tri.v0.x - s.org.x, tri.v0.y - s.org.y, tri.v0.z - s.org.z};
-  const float b[3] = {tri.v1.x - s.org.x, tri.v1.y - s.org.y, tri.v1.z - s.org.z};
-  const float c[3] = {tri.v2.x - s.org.x, tri.v2.y - s.org.y, tri.v2.z - s.org.z};
-  const float ax = a[s.kx] - s.sx * a[s.kz], ay = a[s.ky] - s.sy * a[s.kz];
-  const float bx = b[s.kx] - s.sx * b[s.kz], by = b[s.ky] - s.sy * b[s.kz];
-  const float cx = c[s.kx] - s.sx * c[s.kz], cy = c[s.ky] - s.sy * c[s.kz];
+  // Each permuted coordinate is loaded straight from the triangle (no copy to index into).
+  static_assert(sizeof(Vec3) == 3 * sizeof(float) && std::is_standard_layout_v<Vec3>);
+  const float* o = &s.org.x;
+  const float* p0 = &tri.v0.x;
+  const float* p1 = &tri.v1.x;
+  const float* p2 = &tri.v2.x;
+  const float okx = o[s.kx], oky = o[s.ky], okz = o[s.kz];
+  const float a_z = p0[s.kz] - okz, b_z = p1[s.kz] - okz, c_z = p2[s.kz] - okz;
+  const float ax = (p0[s.kx] - okx) - s.sx * a_z, ay = (p0[s.ky] - oky) - s.sy * a_z;
+  const float bx = (p1[s.kx] - okx) - s.sx * b_z, by = (p1[s.ky] - oky) - s.sy * b_z;
+  const float cx = (p2[s.kx] - okx) - s.sx * c_z, cy = (p2[s.ky] - oky) - s.sy * c_z;
   float u = cx * by - cy * bx;
   float v = ax * cy - ay * cx;
   float w = bx * ay - by * ax;
-  if (u == 0.0f || v == 0.0f || w == 0.0f) [[unlikely]] {
+  if ((u == 0.0f) | (v == 0.0f) | (w == 0.0f)) [[unlikely]] {
     // The float result is ambiguous exactly on an edge: decide it in double, where the products
     // of two floats are exact.
     u = float(double(cx) * double(by) - double(cy) * double(bx));
     v = float(double(ax) * double(cy) - double(ay) * double(cx));
     w = float(double(bx) * double(ay) - double(by) * double(ax));
   }
-  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+  // Bitwise | and & rather than || and &&: each sign is as unpredictable as the ray, and a chain
+  // of short-circuit branches mispredicted often enough to cost 12 % of AO-ray throughput.
+  if (((u < 0.0f) | (v < 0.0f) | (w < 0.0f)) & ((u > 0.0f) | (v > 0.0f) | (w > 0.0f))) return false;
   const float det = u + v + w;
   if (det == 0.0f) return false;  // degenerate, or seen exactly edge-on
-  const float az = s.sz * a[s.kz], bz = s.sz * b[s.kz], cz = s.sz * c[s.kz];
+  const float az = s.sz * a_z, bz = s.sz * b_z, cz = s.sz * c_z;
   const float rcp = 1.0f / det;
   const float t = (u * az + v * bz + w * cz) * rcp;
-  if (!(t >= tnear && t <= tfar && t < kInfinity)) return false;  // also rejects NaN and overflow
+  if (!((t >= tnear) & (t <= tfar) & (t < kInfinity))) return false;  // also rejects NaN and overflow
   out = {t, v * rcp, w * rcp};
   return true;
 }
