@@ -165,7 +165,7 @@ void register_dynamic() {
     {
       // Primary rays of a 1024x1024 image (the renderer's default size, so the packets are as
       // coherent as in a real render): 4x4-pixel packets through the 8-wide BVH, against the
-      // same rays one at a time through the 8-wide BVH and Embree.
+      // same rays one at a time through the binary SAH BVH, the 8-wide BVH and Embree.
       constexpr int kSize = 1024;
       auto wide = std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Bvh8}));
       auto packets = std::make_shared<std::vector<RayPacket>>();
@@ -201,6 +201,7 @@ void register_dynamic() {
         std::shared_ptr<Accelerator> accel;  // null: not built in
       };
       const Named singles_on[] = {
+          {"bvh-sah", std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{}))},
           {"bvh8", wide},
           {"embree", embree_available() ? std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree})) : nullptr}};
       for (const auto& [accel_name, accel] : singles_on) {
