@@ -549,8 +549,7 @@ class BvhBuilder {
     }
     // The sweep compares the split's raw area-count sum and keeps the best in scalars, selected
     // without a branch (which bin wins is unpredictable); the cost is formed once, at the end.
-    int best_axis = -1, best_bin = 0;
-    uint32_t best_left = 0;
+    uint32_t best_choice = 0, best_left = 0;  // axis * kMaxBins + bin
     float best_raw = kInfinity;
     for (int a = 0; a < 3; ++a) {
       if (cbox.hi[a] <= cbox.lo[a]) continue;
@@ -565,17 +564,17 @@ class BvhBuilder {
       for (int s = 1; s < nb; ++s) {
         acc.add(bins.bins[a][s - 1]);
         const float raw = acc.count ? acc.half_area() * float(acc.count) + right_cost[s] : kInfinity;
-        const bool better = raw < best_raw;
-        best_raw = better ? raw : best_raw;
-        best_axis = better ? a : best_axis;
-        best_bin = better ? s : best_bin;
-        best_left = better ? acc.count : best_left;
+        // Masks, not ?:, which the compiler turned back into a branch.
+        const uint32_t better = 0u - uint32_t(raw < best_raw);
+        best_raw = std::min(raw, best_raw);
+        best_choice = (uint32_t(a * kMaxBins + s) & better) | (best_choice & ~better);
+        best_left = (acc.count & better) | (best_left & ~better);
       }
     }
     const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
     SahChoice best;
-    best.axis = best_axis;
-    best.split_bin = best_bin;
+    best.axis = int(best_choice / kMaxBins);
+    best.split_bin = int(best_choice % kMaxBins);
     best.left_count = best_left;
     best.cost = options_.traversal_cost + options_.intersection_cost * best_raw * inv_area;
     if (!(best_raw < kInfinity)) {
