@@ -10,8 +10,9 @@ namespace {
 // address chosen with masks rather than a branch: whether a child is a leaf is as unpredictable
 // as the ray.
 inline void prefetch_child(const BvhNode& c, const BvhNode* nodes, const Triangle* tris) {
-  const uintptr_t node_line = reinterpret_cast<uintptr_t>(nodes + c.index);
-  const uintptr_t tri_line = reinterpret_cast<uintptr_t>(tris + c.index);
+  // Integer arithmetic: the index is only valid for one of the two arrays.
+  const uintptr_t node_line = reinterpret_cast<uintptr_t>(nodes) + uintptr_t(c.index) * sizeof(BvhNode);
+  const uintptr_t tri_line = reinterpret_cast<uintptr_t>(tris) + uintptr_t(c.index) * sizeof(Triangle);
   const uintptr_t leaf = uintptr_t(0) - uintptr_t(c.count != 0);
   __builtin_prefetch(reinterpret_cast<const void*>((tri_line & leaf) | (node_line & ~leaf)));
 }
