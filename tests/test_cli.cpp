@@ -145,7 +145,9 @@ TEST_F(Cli, RendersPngPpmAndStats) {
 
 TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
   // A brute-force render of a few thousand triangles at 2048x2048 runs for minutes; SIGINT after
-  // a second must end it within a fraction of a second with exit code 130.
+  // a second must end it within a fraction of a second with exit code 130. --foreground: without
+  // it `timeout` signals the child and then its whole process group, so the tracer gets SIGINT
+  // twice, and a second Ctrl-C kills at once by design (SA_RESETHAND), which made this test flaky.
   const std::string scene = dir_ + "/many.obj";
   {
     std::ofstream f(scene);
@@ -155,7 +157,7 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
   const std::string exe = TRACER_EXE;
   for (const bool partial : {false, true}) {
     const std::string out = dir_ + (partial ? "/partial.png" : "/none.png");
-    const std::string cmd = "timeout --preserve-status -s INT 1 " + exe + " render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out +
+    const std::string cmd = "timeout --foreground --preserve-status -s INT 1 " + exe + " render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out +
                             (partial ? " --save-partial" : "") + " 2>&1";
     const auto t0 = std::chrono::steady_clock::now();
     const int status = std::system(cmd.c_str());
