@@ -6,17 +6,6 @@
 namespace tracer {
 
 namespace {
-// Requests what visiting child `c` reads first (its children pair, or its first triangle), the
-// address chosen with masks rather than a branch: whether a child is a leaf is as unpredictable
-// as the ray.
-inline void prefetch_child(const BvhNode& c, const BvhNode* nodes, const Triangle* tris) {
-  // Integer arithmetic: the index is only valid for one of the two arrays.
-  const uintptr_t node_line = reinterpret_cast<uintptr_t>(nodes) + uintptr_t(c.index) * sizeof(BvhNode);
-  const uintptr_t tri_line = reinterpret_cast<uintptr_t>(tris) + uintptr_t(c.index) * sizeof(Triangle);
-  const uintptr_t leaf = uintptr_t(0) - uintptr_t(c.count != 0);
-  __builtin_prefetch(reinterpret_cast<const void*>((tri_line & leaf) | (node_line & ~leaf)));
-}
-
 struct ChildHits {
   bool a, b;       // whether the first and second child's boxes are entered within [tnear, tfar]
   float ta, tb;    // their entry distances

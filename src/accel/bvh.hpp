@@ -44,6 +44,16 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32);
 
+// Requests what visiting child `c` reads first (its children pair, or its first triangle), the
+// address chosen with masks rather than a branch: whether a child is a leaf is as unpredictable
+// as the ray. Integer arithmetic, since the index is valid for only one of the two arrays.
+inline void prefetch_child(const BvhNode& c, const BvhNode* nodes, const Triangle* tris) {
+  const uintptr_t node_line = reinterpret_cast<uintptr_t>(nodes) + uintptr_t(c.index) * sizeof(BvhNode);
+  const uintptr_t tri_line = reinterpret_cast<uintptr_t>(tris) + uintptr_t(c.index) * sizeof(Triangle);
+  const uintptr_t leaf = uintptr_t(0) - uintptr_t(c.leaf());
+  __builtin_prefetch(reinterpret_cast<const void*>((tri_line & leaf) | (node_line & ~leaf)));
+}
+
 // Cache-line aligned storage: with sibling pairs at even indices, each pair is one 64-byte line.
 template <class T>
 struct CacheAlignedAllocator {

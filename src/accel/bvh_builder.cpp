@@ -547,8 +547,9 @@ class BvhBuilder {
     } else {
       fill(node.begin, node.end, bins);
     }
-    // The sweep compares the split's raw area-count sum and keeps the best in scalars, selected
-    // without a branch (which bin wins is unpredictable); the cost is formed once, at the end.
+    // The sweep compares the split's raw area-count sum, keeping the best in scalars selected with
+    // masks (which bin wins is unpredictable, and the compiler turned ?: back into a branch); the
+    // cost is formed once, at the end.
     uint32_t best_choice = 0, best_left = 0;  // axis * kMaxBins + bin
     float best_raw = kInfinity;
     for (int a = 0; a < 3; ++a) {
@@ -564,7 +565,6 @@ class BvhBuilder {
       for (int s = 1; s < nb; ++s) {
         acc.add(bins.bins[a][s - 1]);
         const float raw = acc.count ? acc.half_area() * float(acc.count) + right_cost[s] : kInfinity;
-        // Masks, not ?:, which the compiler turned back into a branch.
         const uint32_t better = 0u - uint32_t(raw < best_raw);
         best_raw = std::min(raw, best_raw);
         best_choice = (uint32_t(a * kMaxBins + s) & better) | (best_choice & ~better);

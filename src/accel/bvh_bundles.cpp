@@ -86,8 +86,8 @@ HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, const RayBundle& rays, uint32_
       const BvhNode& a = nodes[n.index];
       const BvhNode& b = nodes[n.index + 1];
       // Request the grandchildren's lines now, so the loads of both paths overlap.
-      __builtin_prefetch(a.leaf() ? static_cast<const void*>(&tris[a.index]) : &nodes[a.index]);
-      __builtin_prefetch(b.leaf() ? static_cast<const void*>(&tris[b.index]) : &nodes[b.index]);
+      prefetch_child(a, nodes, tris);
+      prefetch_child(b, nodes, tris);
       const uint32_t ma = TestBox(a, st, cur.mask);
       const uint32_t mb = TestBox(b, st, cur.mask);
       if (ma | mb) {
