@@ -7,7 +7,7 @@
 #include <string>
 
 #include "accel/bvh.hpp"
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

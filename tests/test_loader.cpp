@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "scene/builtin.hpp"
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer {
 

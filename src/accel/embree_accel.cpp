@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer {
 

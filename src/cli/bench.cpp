@@ -24,7 +24,7 @@
 #include "sched/scheduler.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 
 namespace tracer::cli {

@@ -13,7 +13,7 @@
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
 #include "io/image_io.hpp"
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer::cli {
 namespace {

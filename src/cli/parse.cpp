@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer::cli {
 

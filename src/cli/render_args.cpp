@@ -3,7 +3,7 @@
 #include "cli/parse.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 
 namespace tracer::cli {

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer {
 

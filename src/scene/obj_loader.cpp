@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string_view>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer {
 namespace {

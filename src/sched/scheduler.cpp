@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "scene/errors.hpp"
+#include "base/errors.hpp"
 
 namespace tracer {
 

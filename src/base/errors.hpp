@@ -1,4 +1,5 @@
-// The two kinds of failure a user can cause, with the exit codes the CLI maps them to.
+// The two kinds of failure a user can cause, with the exit codes the CLI maps them to. Every
+// layer throws these; only the CLI turns them into messages and exit codes.
 #pragma once
 
 #include <stdexcept>
