@@ -2,6 +2,11 @@
 // input gives a one-line error that names the file and line.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <atomic>
+#include <thread>
+
 #include <filesystem>
 #include <fstream>
 
@@ -104,6 +109,12 @@ TEST(Loader, BadInputsGiveOneLineErrorsWithLine) {
       {"no_triangles", "v 0 0 0\nv 1 0 0\n", "bad.obj: scene has no triangles"},
       {"empty_file", "", "bad.obj: scene has no triangles"},
       {"huge_number", "v 0 0 1e999\n", "bad.obj:1: number out of range '1e999'"},
+      {"beyond_supported_range", "v 0 0 1e19\n", "bad.obj:1: number out of range '1e19' (coordinates must lie within +-1e18)"},
+      // tinyobjloader ends a line at a lone CR: the vertex after it is a line of its own, checked.
+      {"cr_inside_comment", "# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n", "bad.obj:2: number out of range '1e39'"},
+      {"cr_only_lines", "v 0 0 0\rv 1 0 0\rf 1 2 3\r", "bad.obj:3: vertex index 3 out of range (2 defined so far)"},
+      {"control_character", "v 0 0 0\nv 1\x01 0 0\n", "bad.obj:2: malformed number '1\\x01'"},
+      {"zero_line_index", "v 0 0 0\nv 1 0 0\nl 0 1\n", "bad.obj:3: "},
   };
   for (const BadObj& c : cases) {
     SCOPED_TRACE(c.name);
@@ -116,6 +127,66 @@ TEST(Loader, BadInputsGiveOneLineErrorsWithLine) {
       EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
     }
   }
+}
+
+TEST(Loader, UnusualButValidInputIsAccepted) {
+  // A UTF-8 byte-order mark, a leading '+', exponents that underflow to zero, CR-only line ends.
+  const std::string obj = "\xEF\xBB\xBFv 0 0 0\rv +1 0 1e-50\rv 0 1 1e-400\rf 1 +2 -1\r";
+  const Scene s = load_obj_from_string(obj, "", "unusual.obj");
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s.triangles[0].v1, (Vec3{1, 0, 0}));
+  EXPECT_EQ(s.triangles[0].v2, (Vec3{0, 1, 0}));
+  EXPECT_EQ(s.vertex_count, 3u);
+  // A BOM in the MTL too: the material's name is read without it.
+  const Scene m = load_obj_from_string("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n", "\xEF\xBB\xBFnewmtl red\nKd 1 0 0\n",
+                                       "bom.obj", [](const std::string& w) { ADD_FAILURE() << w; });
+  EXPECT_EQ(m.materials[m.tri_material[0]].name, "red");
+}
+
+TEST(Loader, ManyWarningsOfOneKindMakeOneLine) {
+  std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  for (int i = 0; i < 20000; ++i) obj += "usemtl undefined" + std::to_string(i) + "\nf 1 2 3\n";
+  std::vector<std::string> warnings;
+  const Scene s = load_obj_from_string(obj, "", "many.obj", [&](const std::string& w) { warnings.push_back(w); });
+  EXPECT_EQ(s.size(), 20000u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("undefined0"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("20000 times"), std::string::npos) << warnings[0];
+}
+
+TEST(Loader, ReadsPipesAndNamesTheRealCauseOfOpenErrors) {
+  const std::string dir = test::temp_dir();
+  std::ofstream(dir + "/t.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  // A FIFO is read once, as it streams (opening it twice would hang).
+  const std::string fifo = dir + "/fifo.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; });
+  const Scene s = load_obj(fifo);
+  writer.join();
+  EXPECT_EQ(s.size(), 1u);
+  std::filesystem::create_symlink(dir + "/loop-a", dir + "/loop-b");
+  std::filesystem::create_symlink(dir + "/loop-b", dir + "/loop-a");
+  try {
+    load_obj(dir + "/loop-a");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open: too many levels of symbolic links"), std::string::npos) << e.what();
+  }
+  try {
+    load_obj(dir);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open: is a directory"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Loader, CancelFlagStopsTheLoad) {
+  const std::string dir = test::temp_dir();
+  std::ofstream(dir + "/t.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::atomic<bool> cancel{true};
+  EXPECT_THROW(load_obj(dir + "/t.obj", {}, &cancel), Cancelled);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Loader, MissingFileAndDirectory) {

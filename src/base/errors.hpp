@@ -1,7 +1,8 @@
-// The two kinds of failure a user can cause, with the exit codes the CLI maps them to. Every
+// The failures a user can cause or ask for, with the exit codes the CLI maps them to. Every
 // layer throws these; only the CLI turns them into messages and exit codes.
 #pragma once
 
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -18,5 +19,25 @@ class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// The user stopped the run (a signal) while it was loading or building; the CLI exits with
+// 128 + the signal number. Thrown where the work checks its cancel flag.
+class Cancelled : public std::runtime_error {
+ public:
+  Cancelled() : std::runtime_error("cancelled") {}
+};
+
+// A cancel flag a long phase polls: set asynchronously (by a signal handler or a watchdog).
+using CancelFlag = const std::atomic<bool>*;
+
+inline bool is_cancelled(CancelFlag flag) { return flag && flag->load(std::memory_order_relaxed); }
+inline void throw_if_cancelled(CancelFlag flag) {
+  if (is_cancelled(flag)) throw Cancelled();
+}
+
+// The largest coordinate magnitude a scene, camera or light may have. Beyond it the products in
+// the ray tests (edge cross products, squared distances) overflow float, and Embree rejects
+// such rays outright (its FLT_LARGE is 1.844e18).
+inline constexpr float kMaxCoordinate = 1e18f;
 
 }  // namespace tracer

@@ -1,77 +1,90 @@
 #include "scene/obj_loader.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <tiny_obj_loader.h>
+#include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
+#include <streambuf>
 #include <string_view>
+#include <unordered_map>
 
-#include "base/errors.hpp"
+#include "base/text.hpp"
+#include "io/read_input.hpp"
 
 namespace tracer {
 namespace {
 
 namespace fs = std::filesystem;
 
+// How often the long loops poll the cancel flag: often enough to stop within milliseconds.
+constexpr size_t kCancelStride = 1 << 16;
+
 [[noreturn]] void fail_at(const std::string& name, size_t line, const std::string& what) {
   throw InputError(name + ":" + std::to_string(line) + ": " + what);
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
+// Reads one number of an OBJ line. Accepts what tinyobjloader reads as a number (a leading '+',
+// values that underflow to zero) and rejects what it would silently turn into 0 or infinity.
+float parse_coordinate(std::string_view tok, const std::string& name, size_t line) {
+  std::string_view digits = tok;
+  if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
+  double value = 0;
+  const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (ec == std::errc{} && ptr == digits.data() + digits.size()) {
+    if (!std::isfinite(value)) fail_at(name, line, "non-finite coordinate " + in_quotes(tok));
+    if (std::fabs(value) > double(kMaxCoordinate)) {
+      fail_at(name, line, "number out of range " + in_quotes(tok) + " (coordinates must lie within +-1e18)");
+    }
+    return float(value);
+  }
+  if (ec == std::errc::result_out_of_range && ptr == digits.data() + digits.size()) {
+    // Beyond double's range either way: strtod says which (0 for underflow, HUGE_VAL for overflow).
+    const double approx = std::strtod(std::string(digits).c_str(), nullptr);
+    if (std::fabs(approx) < 1.0) return 0.0f;
+    fail_at(name, line, "number out of range " + in_quotes(tok));
+  }
+  fail_at(name, line, "malformed number " + in_quotes(tok));
 }
 
-std::string_view next_token(std::string_view& s) {
-  s = trim(s);
-  size_t end = 0;
-  while (end < s.size() && s[end] != ' ' && s[end] != '\t') ++end;
-  std::string_view tok = s.substr(0, end);
-  s.remove_prefix(end);
-  return tok;
+long long parse_index(std::string_view part, std::string_view tok, const std::string& name, size_t line) {
+  if (part.size() > 1 && part.front() == '+' && part[1] != '-' && part[1] != '+') part.remove_prefix(1);
+  long long index = 0;
+  const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), index);
+  if (part.empty() || ec != std::errc{} || ptr != part.data() + part.size()) {
+    fail_at(name, line, "malformed face index " + in_quotes(tok));
+  }
+  return index;
 }
 
-std::string quoted(std::string_view tok) {
-  std::string t(tok.substr(0, 40));
-  return "'" + t + (tok.size() > 40 ? "...'" : "'");
-}
-
-// tinyobjloader is lenient by design: it reads an unparsable number as 0, keeps going on short
-// lines and does not range-check face indices (an out-of-range index would later read past the
-// vertex array). This pass rejects all of that with the file and line, before tinyobjloader
-// builds the real data.
-void validate_obj_text(std::string_view text, const std::string& name) {
+// tinyobjloader is lenient by design: it reads an unparsable number as 0 and keeps going on short
+// lines. This lint goes over the same lines (for_each_line splits them as tinyobjloader does) and
+// rejects all of that with the file and line. It is a diagnostic: what tinyobjloader produced is
+// checked again in build_scene, so nothing unchecked reaches the scene even where the two disagree.
+void lint_obj_text(std::string_view text, const std::string& name, CancelFlag cancel) {
   size_t counts[3] = {0, 0, 0};  // v, vt, vn seen so far: OBJ indices refer backwards
-  size_t line_no = 0;
-  while (!text.empty()) {
-    ++line_no;
-    const size_t nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
+  for_each_line(text, [&](std::string_view line, size_t line_no) {
+    if (line_no % kCancelStride == 0) throw_if_cancelled(cancel);
     line = trim(line);
-    if (line.empty() || line.front() == '#') continue;
+    if (line.empty() || line.front() == '#') return;
     const std::string_view keyword = next_token(line);
     if (keyword == "v" || keyword == "vt" || keyword == "vn") {
       const size_t needed = keyword == "vt" ? 1 : 3;
       size_t n = 0;
       for (std::string_view tok = next_token(line); !tok.empty(); tok = next_token(line), ++n) {
-        float value = 0;
-        const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
-        if (ec == std::errc::result_out_of_range) fail_at(name, line_no, "number out of range " + quoted(tok));
-        if (ec != std::errc{} || ptr != tok.data() + tok.size()) fail_at(name, line_no, "malformed number " + quoted(tok));
-        if (!std::isfinite(value)) fail_at(name, line_no, "non-finite coordinate " + quoted(tok));
+        parse_coordinate(tok, name, line_no);
       }
       if (n < needed) {
-        fail_at(name, line_no, "'" + std::string(keyword) + "' needs " + std::to_string(needed) +
-                                   " numbers, got " + std::to_string(n));
+        fail_at(name, line_no, "'" + std::string(keyword) + "' needs " + std::to_string(needed) + " numbers, got " + std::to_string(n));
       }
       ++counts[keyword == "v" ? 0 : (keyword == "vt" ? 1 : 2)];
     } else if (keyword == "f") {
@@ -84,75 +97,211 @@ void validate_obj_text(std::string_view text, const std::string& name) {
           const std::string_view part = rest.substr(0, slash);
           rest.remove_prefix(slash == std::string_view::npos ? rest.size() : slash + 1);
           if (part.empty() && slot == 1) continue;  // v//vn
-          long long index = 0;
-          const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), index);
-          if (ec != std::errc{} || ptr != part.data() + part.size() || part.empty()) {
-            fail_at(name, line_no, "malformed face index " + quoted(tok));
-          }
+          const long long index = parse_index(part, tok, name, line_no);
           const auto count = static_cast<long long>(counts[slot]);
           if (index == 0 || index > count || index < -count) {
             static const char* kinds[3] = {"vertex", "texture coordinate", "normal"};
-            fail_at(name, line_no, std::string(kinds[slot]) + " index " + std::to_string(index) +
-                                       " out of range (" + std::to_string(count) + " defined so far)");
+            fail_at(name, line_no, std::string(kinds[slot]) + " index " + std::to_string(index) + " out of range (" +
+                                       std::to_string(count) + " defined so far)");
           }
         }
       }
       if (corners < 3) fail_at(name, line_no, "face needs at least 3 vertices, got " + std::to_string(corners));
     }
+  });
+}
+
+// tinyobjloader reads its input through a stream; this one serves the bytes already in memory and
+// polls the cancel flag between chunks, so a Ctrl-C stops the parse of a large file at once.
+class CancellableBuffer : public std::streambuf {
+ public:
+  CancellableBuffer(std::string_view bytes, CancelFlag cancel) : bytes_(bytes), cancel_(cancel) {}
+
+ protected:
+  int_type underflow() override {
+    throw_if_cancelled(cancel_);
+    if (served_ >= bytes_.size()) return traits_type::eof();
+    char* begin = const_cast<char*>(bytes_.data()) + served_;  // read-only use: get area only
+    const size_t n = std::min<size_t>(bytes_.size() - served_, 1 << 20);
+    setg(begin, begin, begin + n);
+    served_ += n;
+    return traits_type::to_int_type(*begin);
   }
+
+ private:
+  std::string_view bytes_;
+  CancelFlag cancel_;
+  size_t served_ = 0;
+};
+
+// Resolves `mtllib` names: from files beside the OBJ (each read once, like the OBJ), or from one
+// text in memory (tests, fuzzing).
+class MtlSource : public tinyobj::MaterialReader {
+ public:
+  static MtlSource from_directory(fs::path dir) { return MtlSource(std::move(dir), {}, false); }
+  static MtlSource from_text(std::string text) { return MtlSource({}, std::move(text), true); }
+
+  bool operator()(const std::string& mtl_name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
+    std::string text;
+    if (in_memory_) {
+      text = text_;
+    } else {
+      const fs::path path = dir_ / mtl_name;
+      try {
+        text = read_input(path.string());
+      } catch (const InputError& e) {
+        if (warn) *warn += std::string(e.what()) + "\n";
+        return false;
+      }
+    }
+    strip_bom(text);
+    std::istringstream in(text);
+    tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+    return true;
+  }
+
+ private:
+  MtlSource(fs::path dir, std::string text, bool in_memory) : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory) {}
+  fs::path dir_;
+  std::string text_;
+  bool in_memory_;
+};
+
+// Groups warnings by kind (the text with its quoted names and numbers left out), so 80,000
+// undefined material names make one line with a count and the first place, not 80,000 lines.
+class WarningLog {
+ public:
+  void add(const std::string& message) {
+    const std::string key = kind_of(message);
+    auto [it, inserted] = index_.try_emplace(key, entries_.size());
+    if (inserted) entries_.push_back({message, 0});
+    ++entries_[it->second].count;
+  }
+  void add_lines(const std::string& text) {
+    size_t begin = 0;
+    while (begin < text.size()) {
+      size_t end = text.find('\n', begin);
+      if (end == std::string::npos) end = text.size();
+      const std::string_view line = trim(std::string_view(text).substr(begin, end - begin));
+      if (!line.empty()) add(std::string(line));
+      begin = end + 1;
+    }
+  }
+  void flush(const std::string& name, const WarningSink& sink) const {
+    for (const Entry& e : entries_) {
+      std::string line = name + ": " + escaped(e.first);
+      if (e.count > 1) line += " (" + std::to_string(e.count) + " times; the first shown)";
+      sink(line);
+    }
+  }
+
+ private:
+  static std::string kind_of(std::string_view message) {
+    std::string key;
+    char quote = 0;
+    for (char c : message) {
+      if (quote) {
+        if (c == quote) quote = 0, key += c;
+        continue;
+      }
+      if (c == '\'' || c == '"') quote = c;
+      if (c >= '0' && c <= '9') {
+        if (key.empty() || key.back() != '#') key += '#';
+        continue;
+      }
+      key += c;
+    }
+    return key;
+  }
+  struct Entry {
+    std::string first;
+    size_t count;
+  };
+  std::vector<Entry> entries_;
+  std::unordered_map<std::string, size_t> index_;
+};
+
+Material to_material(const tinyobj::material_t& m, const std::string& name) {
+  Material mat;
+  mat.name = m.name;
+  mat.kd = {float(m.diffuse[0]), float(m.diffuse[1]), float(m.diffuse[2])};
+  mat.ks = {float(m.specular[0]), float(m.specular[1]), float(m.specular[2])};
+  mat.ke = {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])};
+  mat.ni = float(m.ior);
+  mat.illum = m.illum;
+  if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !std::isfinite(mat.ni)) {
+    throw InputError(name + ": material " + in_quotes(m.name) + " has a non-finite colour or index");
+  }
+  return mat;
 }
 
-std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path + ": cannot open: no such file");
-  if (fs::is_directory(path, ec)) throw InputError(path + ": cannot open: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": read error");
-  return ss.str();
+struct Parsed {
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+};
+
+// tinyobjloader's errors say "line N" somewhere in their text; ours start with file:N.
+std::string parser_error(const std::string& name, const std::string& err) {
+  const std::string first = std::string(trim(std::string_view(err).substr(0, err.find('\n'))));
+  const size_t at = first.find("line ");
+  if (at != std::string::npos) {
+    size_t line = 0;
+    const char* b = first.data() + at + 5;
+    const auto [ptr, ec] = std::from_chars(b, first.data() + first.size(), line);
+    if (ec == std::errc{} && ptr != b) return name + ":" + std::to_string(line) + ": " + escaped(first);
+  }
+  return name + ": " + (first.empty() ? std::string("parse error") : escaped(first));
 }
 
-void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
+Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, WarningLog& warnings, CancelFlag cancel) {
+  lint_obj_text(text, name, cancel);
+  Parsed p;
+  CancellableBuffer buffer(text, cancel);
+  std::istream in(&buffer);
+  std::string warn, err;
+  const bool ok = tinyobj::LoadObj(&p.attrib, &p.shapes, &p.materials, &warn, &err, &in, &mtl, /*triangulate=*/true,
+                                   /*default_vcols_fallback=*/false);
+  warnings.add_lines(warn);
+  if (!ok || !err.empty()) throw InputError(parser_error(name, err));
+  return p;
+}
 
-Scene build_scene(const tinyobj::ObjReader& reader, const std::string& name, const fs::path& base_dir,
-                  const WarningSink& warn) {
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+// Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
+// finite and within range, every face index inside the vertex array, material ids in range.
+Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings, CancelFlag cancel) {
+  const tinyobj::attrib_t& attrib = parsed.attrib;
   Scene scene;
   scene.source = name;
   scene.vertex_count = attrib.vertices.size() / 3;
+  for (size_t i = 0; i < attrib.vertices.size(); ++i) {
+    const float c = attrib.vertices[i];
+    if (!std::isfinite(c) || std::fabs(c) > kMaxCoordinate) {
+      throw InputError(name + ": vertex " + std::to_string(i / 3 + 1) + " has a coordinate out of range (" + std::to_string(c) + ")");
+    }
+  }
 
   size_t missing_textures = 0;
   std::string first_missing;
-  for (const tinyobj::material_t& m : reader.GetMaterials()) {
-    Material mat;
-    mat.name = m.name;
-    mat.kd = {float(m.diffuse[0]), float(m.diffuse[1]), float(m.diffuse[2])};
-    mat.ks = {float(m.specular[0]), float(m.specular[1]), float(m.specular[2])};
-    mat.ke = {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])};
-    mat.ni = float(m.ior);
-    mat.illum = m.illum;
-    if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !std::isfinite(mat.ni)) {
-      throw InputError(name + ": material '" + m.name + "' has a non-finite colour or index");
-    }
-    for (const std::string* tex : {&m.diffuse_texname, &m.ambient_texname, &m.specular_texname,
-                                   &m.bump_texname, &m.alpha_texname}) {
+  for (const tinyobj::material_t& m : parsed.materials) {
+    for (const std::string* tex : {&m.diffuse_texname, &m.ambient_texname, &m.specular_texname, &m.bump_texname, &m.alpha_texname}) {
       std::error_code ec;
       if (!tex->empty() && !fs::exists(base_dir / *tex, ec)) {
         if (missing_textures++ == 0) first_missing = *tex;
       }
     }
-    scene.materials.push_back(std::move(mat));
+    scene.materials.push_back(to_material(m, name));
   }
   if (missing_textures > 0) {
-    warn(name + ": " + std::to_string(missing_textures) + " texture reference(s) not found (first: '" +
-         first_missing + "'); using material colours");
+    warnings.add(std::to_string(missing_textures) + " texture reference(s) not found (first: " + in_quotes(first_missing) +
+                 "); using material colours");
   }
   const auto default_material = static_cast<uint32_t>(scene.materials.size());
   bool used_default = false;
 
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+  size_t faces_seen = 0;
+  for (const tinyobj::shape_t& shape : parsed.shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     Geometry g;
     g.name = shape.name;
@@ -160,13 +309,15 @@ Scene build_scene(const tinyobj::ObjReader& reader, const std::string& name, con
     const auto geom_id = static_cast<uint32_t>(scene.geometries.size());
     size_t offset = 0;
     for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+      if (++faces_seen % kCancelStride == 0) throw_if_cancelled(cancel);
       const size_t fv = mesh.num_face_vertices[f];
+      if (offset + fv > mesh.indices.size()) throw InputError(name + ": face " + std::to_string(faces_seen) + " is incomplete");
       if (fv == 3) {
         Vec3 p[3];
         for (size_t k = 0; k < 3; ++k) {
           const auto vi = static_cast<size_t>(mesh.indices[offset + k].vertex_index);
-          if (vi >= scene.vertex_count) throw InputError(name + ": face vertex index out of range");
-          p[k] = {float(attrib.vertices[3 * vi]), float(attrib.vertices[3 * vi + 1]), float(attrib.vertices[3 * vi + 2])};
+          if (vi >= scene.vertex_count) throw InputError(name + ": face " + std::to_string(faces_seen) + " has a vertex index out of range");
+          p[k] = {attrib.vertices[3 * vi], attrib.vertices[3 * vi + 1], attrib.vertices[3 * vi + 2]};
         }
         const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
         uint32_t material = default_material;
@@ -191,53 +342,31 @@ Scene build_scene(const tinyobj::ObjReader& reader, const std::string& name, con
   return scene;
 }
 
-void forward_warnings(const std::string& text, const std::string& name, const WarningSink& warn) {
-  // tinyobjloader repeats some warnings once per use of a material: report each once.
-  std::istringstream lines(text);
-  std::vector<std::string> seen;
-  for (std::string line; std::getline(lines, line);) {
-    const std::string t(trim(line));
-    if (t.empty() || std::find(seen.begin(), seen.end(), t) != seen.end()) continue;
-    seen.push_back(t);
-    warn(name + ": " + t);
-  }
-}
+void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
-std::string first_line(const std::string& text) {
-  const std::string_view t = trim(std::string_view(text).substr(0, text.find('\n')));
-  return t.empty() ? "parse error" : std::string(t);
+Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl, const WarningSink& warn_in,
+           CancelFlag cancel) {
+  const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
+  strip_bom(text);
+  WarningLog warnings;
+  const Parsed parsed = parse(text, name, mtl, warnings, cancel);
+  Scene scene = build_scene(parsed, name, base_dir, warnings, cancel);
+  warnings.flush(name, warn);
+  return scene;
 }
 
 }  // namespace
 
-Scene load_obj(const std::string& path, const WarningSink& warn_in) {
-  const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
-  const std::string text = read_file(path);
-  validate_obj_text(text, path);
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  const fs::path base_dir = fs::path(path).parent_path();
-  config.mtl_search_path = base_dir.empty() ? std::string("./") : base_dir.string() + "/";
-  tinyobj::ObjReader reader;
-  // ParseFromString cannot resolve `mtllib` against a directory, so let tinyobjloader read the
-  // file itself; the validation above already read and vetted its text.
-  if (!reader.ParseFromFile(path, config)) throw InputError(path + ": " + first_line(reader.Error()));
-  forward_warnings(reader.Warning(), path, warn);
-  return build_scene(reader, path, base_dir, warn);
+Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel) {
+  std::string text = read_input(path, cancel);
+  const fs::path base_dir = path == "-" ? fs::path() : fs::path(path).parent_path();
+  return load(text, path == "-" ? std::string("<stdin>") : path, base_dir,
+              MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir), warn, cancel);
 }
 
-Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text,
-                           const std::string& name, const WarningSink& warn_in) {
-  const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
-  validate_obj_text(obj_text, name);
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromString(obj_text, mtl_text, config)) throw InputError(name + ": " + first_line(reader.Error()));
-  forward_warnings(reader.Warning(), name, warn);
-  return build_scene(reader, name, fs::path("."), warn);
+Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name, const WarningSink& warn) {
+  std::string text = obj_text;
+  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr);
 }
 
 }  // namespace tracer

@@ -1,23 +1,30 @@
-// OBJ/MTL loading through tinyobjloader, with the validation tinyobjloader does not do.
+// OBJ/MTL loading: the bytes are read once, tinyobjloader parses them, and what it produced is
+// checked before it becomes a Scene. A line-aware lint over the same lines (split exactly as
+// tinyobjloader splits them) names the file and line of malformed text that tinyobjloader would
+// silently read as 0.
 #pragma once
 
 #include <functional>
 #include <string>
 
+#include "base/errors.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
 
-// Receives non-fatal problems (a missing MTL or texture); default prints to stderr.
+// Receives non-fatal problems (a missing MTL or texture), one line per kind of problem with a
+// count and the first place; the default prints to stderr.
 using WarningSink = std::function<void(const std::string&)>;
 
-// Loads an OBJ file (and its MTL) into a finalized Scene. Throws InputError with a one-line
-// message naming the file and, where there is one, the line.
-Scene load_obj(const std::string& path, const WarningSink& warn = {});
+// Loads an OBJ file (and its MTL) into a finalized Scene. `path` may be any readable file,
+// including a pipe; "-" reads standard input (MTL files then resolve from the current directory).
+// Throws InputError with a one-line message naming the file and, where there is one, the line;
+// Cancelled when `cancel` is set during loading.
+Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr);
 
 // The same from memory (fuzzing, tests); `name` stands for the file in messages, and `mtl_text`
 // serves every `mtllib` the OBJ names.
-Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text,
-                           const std::string& name, const WarningSink& warn = {});
+Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
+                           const WarningSink& warn = {});
 
 }  // namespace tracer
