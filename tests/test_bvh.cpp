@@ -293,5 +293,30 @@ TEST(BvhAgreement, EmbreeAgreesOnCornellScenes) {
   }
 }
 
+TEST(BvhBuild, CancelFlagStopsEveryBuilderAndEmbree) {
+  // A set flag makes each builder stop splitting and the constructor throw, whatever the mode.
+  const Scene scene = make_cornell_box(20000);
+  std::atomic<bool> cancel{true};
+  for (const BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+    for (const AccelKind kind : {AccelKind::Bvh, AccelKind::Bvh8}) {
+      AccelOptions o;
+      o.kind = kind;
+      o.bvh.mode = mode;
+      o.bvh.cancel = &cancel;
+      EXPECT_THROW(build_accelerator(scene, o), Cancelled);
+    }
+  }
+  if (embree_available()) {
+    AccelOptions o;
+    o.kind = AccelKind::Embree;
+    o.bvh.cancel = &cancel;
+    EXPECT_THROW(build_accelerator(scene, o), Cancelled);
+  }
+  cancel = false;  // and an unset flag changes nothing
+  AccelOptions o;
+  o.bvh.cancel = &cancel;
+  EXPECT_EQ(std::get<Bvh>(*build_accelerator(scene, o).impl).validate(), "");
+}
+
 }  // namespace
 }  // namespace tracer

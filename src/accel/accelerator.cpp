@@ -45,7 +45,7 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       break;
     case AccelKind::Embree:
 #ifdef TRACER_HAVE_EMBREE
-      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene);
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene, options.bvh.cancel);
       acc.name = "embree";
       break;
 #else

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accel/triangle_test.hpp"
+#include "base/errors.hpp"
 #include "math/aabb.hpp"
 #include "math/ray_packet.hpp"
 #include "scene/scene.hpp"
@@ -31,6 +32,9 @@ struct BvhBuildOptions {
   // on every scene (docs/BENCHMARKS.md section 4), with 10-25 % fewer nodes to build and store.
   float traversal_cost = 1.5f;
   float intersection_cost = 1.0f;
+  // Polled once per node split: when set, the build stops splitting and the constructor throws
+  // Cancelled (a Ctrl-C during a long build).
+  CancelFlag cancel = nullptr;
 };
 
 // 32 bytes: count == 0 marks an interior node whose children are nodes[index] and nodes[index+1];

@@ -354,6 +354,7 @@ class BvhBuilder {
   // Decides node `id`: a leaf (false) or two children (true), placed at *cursor (which advances)
   // or, without one, wherever the shared node counter says.
   bool split(uint32_t id, bool parallel, uint32_t* cursor = nullptr) {
+    if (is_cancelled(options_.cancel)) return false;  // the constructor then throws Cancelled
     BuildNode& node = nodes_[id];
     const uint32_t begin = node.begin, end = node.end, count = end - begin;
     PrimRef* refs = buffers_[node.buffer].get();
@@ -705,6 +706,7 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
   } else {
     construct();
   }
+  throw_if_cancelled(options.cancel);
 }
 
 }  // namespace tracer

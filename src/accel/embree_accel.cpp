@@ -15,7 +15,7 @@ bool EmbreeAccel::monitor(void* user, ssize_t bytes, bool /*post*/) {
   return true;
 }
 
-EmbreeAccel::EmbreeAccel(const Scene& scene) : scene_(&scene) {
+EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel) : scene_(&scene) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
@@ -41,8 +41,18 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) : scene_(&scene) {
     rtcAttachGeometry(rtc_scene_, geom);
     rtcReleaseGeometry(geom);
   }
+  // Embree asks this during the build; false cancels it (a Ctrl-C during a long build).
+  rtcSetSceneProgressMonitorFunction(
+      rtc_scene_, [](void* flag, double) { return !is_cancelled(static_cast<CancelFlag>(flag)); }, const_cast<std::atomic<bool>*>(cancel));
   rtcCommitScene(rtc_scene_);
-  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw InputError("embree: scene build failed");
+  const bool cancelled = is_cancelled(cancel), failed = rtcGetDeviceError(device_) != RTC_ERROR_NONE;
+  if (cancelled || failed) {
+    // The destructor does not run for a throwing constructor.
+    rtcReleaseScene(rtc_scene_);
+    rtcReleaseDevice(device_);
+    if (cancelled) throw Cancelled();
+    throw InputError("embree: scene build failed");
+  }
 }
 
 EmbreeAccel::~EmbreeAccel() {

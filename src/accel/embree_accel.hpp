@@ -6,6 +6,7 @@
 
 #include <atomic>
 
+#include "base/errors.hpp"
 #include "math/ray.hpp"
 #include "scene/scene.hpp"
 
@@ -13,7 +14,7 @@ namespace tracer {
 
 class EmbreeAccel {
  public:
-  explicit EmbreeAccel(const Scene& scene);
+  explicit EmbreeAccel(const Scene& scene, CancelFlag cancel = nullptr);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

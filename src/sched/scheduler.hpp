@@ -8,6 +8,7 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "base/errors.hpp"
 #include "render/shading.hpp"
 #include "sched/thread_count.hpp"
 
@@ -30,12 +31,12 @@ struct SchedOptions {
 
 // Shared between the scheduler, the caller (progress, cancellation) and tests.
 struct RenderControl {
-  std::atomic<bool>* cancel = nullptr;          // set (e.g. by SIGINT) to stop at the next tile
+  CancelFlag cancel = nullptr;  // set (e.g. by SIGINT) to stop at the next tile
   std::atomic<uint64_t> pixels_done{0};
   std::atomic<uint64_t> rays_done{0};
   AtomicRayCounts counts;
   std::function<void(const Tile&)> on_tile;     // test hook, called once per rendered tile
-  bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+  bool cancelled() const { return is_cancelled(cancel); }
 };
 
 // Renders ctx.framebuffer with `accel`. Returns false if cancelled before finishing (tiles not
