@@ -2,12 +2,16 @@
 // image left behind by a failed run.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "io/image_io.hpp"
 #include "test_util.hpp"
@@ -37,6 +41,7 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ + "/range.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
     std::ofstream(dir_ + "/empty.obj") << "# nothing\n";
     std::ofstream(dir_ + "/ok.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+    std::ofstream(dir_ + "/same.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string dir_;
@@ -77,11 +82,20 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
       {"render --traversal-cost 0", 2, "--traversal-cost: must be above 0"},
       {"render --traversal-cost nan", 2, "--traversal-cost"},
+      {"render --eye 0,1,1e19 --look 0,1,0", 2, "--eye: coordinates must lie within +-1e18, got '0,1,1e19'"},
+      {"render --light 1e30,0,0", 2, "--light: coordinates must lie within +-1e18"},
+      {"render SAME", 1, "same.obj: all vertices coincide"},
+      {"render RANGE --stats-json RANGE", 2, "range.obj' is the input scene"},
+      {"bench --variants ''", 2, "--variants: empty name in ''"},
+      {"bench --scenes ,", 2, "--scenes: empty name in ','"},
+      {"bench --size 32x32x99junk", 2, "--size: expected WxH (two whole numbers), got '32x32x99junk'"},
+      {"bench --size 99999999999x2", 2, "--size width: must be between 1 and 16384, got 99999999999"},
+      {"bench --threads 0", 2, "--threads: must be between 1 and 1024, got 0"},
   };
   for (const CliCase& c : cases) {
     std::string args = c.args;
-    for (const auto& [key, file] : {std::pair{"NAN", "nan.obj"}, {"RANGE", "range.obj"}, {"EMPTY", "empty.obj"}}) {
-      if (const size_t p = args.find(key); p != std::string::npos) args.replace(p, std::string(key).size(), dir_ + "/" + file);
+    for (const auto& [key, file] : {std::pair{"NAN", "nan.obj"}, {"RANGE", "range.obj"}, {"EMPTY", "empty.obj"}, {"SAME", "same.obj"}}) {
+      for (size_t p = args.find(key); p != std::string::npos; p = args.find(key)) args.replace(p, std::string(key).size(), dir_ + "/" + file);
     }
     if (args.rfind("render", 0) == 0) args += out;
     SCOPED_TRACE(args);
@@ -106,6 +120,58 @@ TEST_F(Cli, OutputErrors) {
   EXPECT_NE(r.output.find("-o: unsupported image extension '.jpg'"), std::string::npos) << r.output;
   r = test::run_tracer("render " + scene + " -q --width 8 --height 8 -o " + dir_);
   EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
+  // A scene path with a quote and a backslash: the JSON must escape both.
+  const std::string scene = dir_ + "/a\"b\\c.obj";
+  fs::copy_file(dir_ + "/ok.obj", scene);
+  const std::string quoted_scene = "'" + scene + "'";
+  auto r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " + quoted_scene);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is the input scene"), std::string::npos) << r.output;
+  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " + dir_ + "/./x.png");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is also the -o image"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 6 --ao 2 -o " + dir_ + "/x.png --stats-json " + dir_ + "/s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir_ + "/s.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["scene"], scene);
+  EXPECT_EQ(j["rays"]["primary"], 48);
+  EXPECT_EQ(j["width"], 8);
+}
+
+TEST_F(Cli, BenchJsonParsesBack) {
+  const auto r = test::run_tracer("bench --scenes builtin --variants sah,bvh8 --size 8x8 --ao 1 --runs 1 --best 1 --json " + dir_ + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir_ + "/b.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["cells"].size(), 2u);
+  EXPECT_EQ(j["cells"][0]["scene"], "builtin");
+  EXPECT_EQ(j["size"][0], 8);
+}
+
+TEST_F(Cli, MoreThreadsThanCoresRunAsAskedWithOurWarning) {
+  const auto r = test::run_tracer("render -q --width 16 --height 16 --ao 1 --threads 64 --stats -o " + dir_ + "/t.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("TBB Warning"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("tbb, 64 threads"), std::string::npos) << r.output;
+  if (std::thread::hardware_concurrency() < 64) {
+    EXPECT_NE(r.output.find("tracer: warning: --threads 64"), std::string::npos) << r.output;
+  }
+}
+
+TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {
+  const std::string ref = dir_ + "/ref.png";
+  ASSERT_EQ(test::run_tracer("render " + dir_ + "/ok.obj -q --width 16 --height 16 -o " + ref).exit_code, 0);
+  auto r = test::run_tracer("render - -q --width 16 --height 16 -o " + dir_ + "/stdin.png < " + dir_ + "/ok.obj");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/stdin.png").rgb, read_image(ref).rgb);
+  r = test::run_tracer("render /dev/stdin -q --width 16 --height 16 -o " + dir_ + "/pipe.png < " + dir_ + "/ok.obj");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/pipe.png").rgb, read_image(ref).rgb);
 }
 
 TEST_F(Cli, RendersPngPpmAndStats) {
@@ -172,6 +238,51 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
     }
   }
   for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+}
+
+// Runs `args` under `timeout --foreground --preserve-status -s SIG 1`: one signal after a second.
+int run_signalled(const std::string& sig, const std::string& args) {
+  const std::string cmd = "timeout --foreground --preserve-status -s " + sig + " 1 " + std::string(TRACER_EXE) + " " + args + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+TEST_F(Cli, TermAndHupStopLikeCtrlC) {
+  const std::string scene = dir_ + "/many.obj";
+  {
+    std::ofstream f(scene);
+    for (int i = 0; i < 2000; ++i) f << "v " << i % 50 << " " << i / 50 << " 0\n";
+    for (int i = 1; i + 51 <= 2000; ++i) f << "f " << i << " " << i + 1 << " " << i + 50 << "\n";
+  }
+  for (const auto& [sig, code] : {std::pair{"TERM", 143}, {"HUP", 129}}) {
+    SCOPED_TRACE(sig);
+    const std::string out = dir_ + "/out.png";
+    EXPECT_EQ(run_signalled(sig, "render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out), code);
+    EXPECT_FALSE(fs::exists(out));
+  }
+  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+}
+
+TEST_F(Cli, CtrlCWhileTheSceneIsStillArrivingStopsWithoutAnImage) {
+  // The scene is a FIFO whose writer never finishes: without a cancellable read this hangs.
+  const std::string fifo = dir_ + "/slow.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string out = dir_ + "/out.png";
+  {
+    std::ofstream script(dir_ + "/run.sh");
+    script << "sleep 30 > " << fifo << " & holder=$!\n"
+           << "timeout --foreground --preserve-status -s INT 1 " << TRACER_EXE << " render " << fifo << " -q --save-partial -o " << out
+           << " > " << dir_ << "/log.txt 2>&1\necho $? > " << dir_ << "/code.txt\nkill $holder\n";
+  }
+  ASSERT_EQ(std::system(("bash " + dir_ + "/run.sh").c_str()), 0);
+  std::ifstream code(dir_ + "/code.txt");
+  int exit_code = -1;
+  code >> exit_code;
+  EXPECT_EQ(exit_code, 130);
+  std::ifstream log(dir_ + "/log.txt");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(text.find("interrupted; no image written"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace

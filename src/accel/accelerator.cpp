@@ -23,8 +23,14 @@ size_t Accelerator::memory_bytes() const {
   return visit([](const auto& a) { return a.memory_bytes(); });
 }
 
+std::optional<BvhStats> Accelerator::bvh_stats() const {
+  if (const auto* bvh = std::get_if<Bvh>(impl.get())) return bvh->stats();
+  return std::nullopt;
+}
+
 Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
   Accelerator acc;
+  acc.kind = options.kind;
   const auto start = std::chrono::steady_clock::now();
   switch (options.kind) {
     case AccelKind::Brute:

@@ -6,6 +6,7 @@
 
 #include <concepts>
 #include <memory>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -39,12 +40,15 @@ using AccelVariant = std::variant<BruteForce, SimdBruteForce, Bvh, WideBvh
 
 struct Accelerator {
   std::unique_ptr<AccelVariant> impl;  // heap: Embree's handle and the BVH must not move mid-render
+  AccelKind kind = AccelKind::Bvh;
   double build_ms = 0.0;
   std::string name;
 
   template <class F>
   decltype(auto) visit(F&& f) const { return std::visit(std::forward<F>(f), *impl); }
   size_t memory_bytes() const;
+  // The binary BVH's shape (nodes, leaves, depth, SAH cost); empty for the other accelerators.
+  std::optional<BvhStats> bvh_stats() const;
 };
 
 bool embree_available();

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -94,8 +96,7 @@ std::string shared_scenes_dir() {
 std::vector<SceneEntry> resolve_scenes(const std::string& spec) {
   const std::string dir = shared_scenes_dir();
   std::vector<SceneEntry> out;
-  std::stringstream ss(spec);
-  for (std::string item; std::getline(ss, item, ',');) {
+  for (const std::string& item : split_list("--scenes", spec)) {
     if (item == "cornell" || item == "all") {
       for (const char* n : {"Original", "Mirror", "Sphere", "Water"}) out.push_back({n, dir + "/cornell-box/CornellBox-" + n + ".obj"});
     }
@@ -117,8 +118,7 @@ std::vector<SceneEntry> resolve_scenes(const std::string& spec) {
 
 std::vector<Variant> resolve_variants(const std::string& spec) {
   std::vector<Variant> out;
-  std::stringstream ss(spec);
-  for (std::string item; std::getline(ss, item, ',');) {
+  for (const std::string& item : split_list("--variants", spec)) {
     bool found = false;
     for (const Variant& v : all_variants()) {
       const bool group = item == "all" || (item == "study" && v.study) || (item == "ours" && !v.study);
@@ -133,6 +133,7 @@ std::vector<Variant> resolve_variants(const std::string& spec) {
     }
     if (!found) throw UsageError("--variants: unknown variant '" + item + "' (see tracer bench --list)");
   }
+  if (out.empty()) throw UsageError("--variants: no variant left to run (Embree is not in this build)");
   return out;
 }
 
@@ -250,14 +251,13 @@ int run_bench(const BenchArgs& a) {
     for (const Variant& v : all_variants()) std::printf("%-24s %s%s\n", v.name.c_str(), v.description.c_str(), v.study ? " (study)" : "");
     return 0;
   }
-  int width = 0, height = 0;
-  if (std::sscanf(a.size.c_str(), "%dx%d", &width, &height) != 2) throw UsageError("--size: expected WxH, got '" + a.size + "'");
-  check_range("--size width", width, 1, 16384);
-  check_range("--size height", height, 1, 16384);
+  const auto [width, height] = parse_size("--size", a.size);
   check_range("--ao", a.ao, 0, 4096);
   check_range("--runs", a.runs, 1, 1000);
   check_range("--best", a.best, 1, a.runs);
-  if (a.threads != 0) check_range("--threads", a.threads, 1, 1024);
+  if (a.threads) check_range("--threads", *a.threads, 1, 1024);
+  const int threads = a.threads.value_or(0);
+  const ThreadLimit thread_limit(threads);
   check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, true);
   const std::vector<Variant> variants = resolve_variants(a.variants);
   const std::vector<SceneEntry> scenes = resolve_scenes(a.scenes);
@@ -294,7 +294,7 @@ int run_bench(const BenchArgs& a) {
         ao.kind = v.accel;
         ao.bvh.split = v.split;
         ao.bvh.mode = v.build;
-        ao.bvh.threads = a.threads;
+        ao.bvh.threads = threads;
         const Accelerator accel = build_accelerator(scene, ao);
         RenderSettings rs;
         rs.width = width;
@@ -308,7 +308,7 @@ int run_bench(const BenchArgs& a) {
         control.cancel = &stop;
         SchedOptions so;
         so.kind = v.sched;
-        so.threads = a.threads;
+        so.threads = threads;
         const auto t0 = Clock::now();
         bool finished;
         {
@@ -355,7 +355,7 @@ int run_bench(const BenchArgs& a) {
   };
   const std::string timeout_text = "> " + fmt(a.max_seconds, 0) + " s";
   md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs << " runs, mean of best " << a.best
-     << ", threads " << (a.threads ? std::to_string(a.threads) : std::to_string(resolve_thread_count(0))) << "\n";
+     << ", threads " << resolve_thread_count(threads) << "\n";
   header("Build + render time, ms (k-best mean)");
   row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? timeout_text : fmt(c.total_ms); });
   header("Build time, ms");
@@ -391,21 +391,13 @@ int run_bench(const BenchArgs& a) {
   std::cout << md.str();
   if (!a.markdown.empty()) write_file_atomic(a.markdown, md.str());
   if (!a.json.empty()) {
-    std::ostringstream j;
-    j << "{\n  \"size\": [" << width << ", " << height << "], \"ao\": " << a.ao << ", \"runs\": " << a.runs << ", \"best\": " << a.best
-      << ",\n  \"cells\": [\n";
-    bool first = true;
+    nlohmann::json j = {{"size", {width, height}}, {"ao", a.ao}, {"runs", a.runs}, {"best", a.best}, {"cells", nlohmann::json::array()}};
     for (const auto& [key, c] : cells) {
-      j << (first ? "" : ",\n") << "    {\"scene\": \"" << c.scene << "\", \"variant\": \"" << c.variant << "\", \"triangles\": " << c.triangles
-        << ", \"timed_out\": " << (c.timed_out ? "true" : "false") << ", \"load_ms\": " << c.load_ms << ", \"build_ms\": " << c.build_ms
-        << ", \"render_ms\": " << c.render_ms << ", \"total_ms\": " << c.total_ms << ", \"rays\": " << c.rays << ", \"mrays_per_s\": " << c.mrays
-        << ", \"runs_ms\": [";
-      for (size_t i = 0; i < c.run_ms.size(); ++i) j << (i ? ", " : "") << c.run_ms[i];
-      j << "]}";
-      first = false;
+      j["cells"].push_back({{"scene", c.scene}, {"variant", c.variant}, {"triangles", c.triangles}, {"timed_out", c.timed_out},
+                            {"load_ms", c.load_ms}, {"build_ms", c.build_ms}, {"render_ms", c.render_ms}, {"total_ms", c.total_ms},
+                            {"rays", c.rays}, {"mrays_per_s", c.mrays}, {"runs_ms", c.run_ms}});
     }
-    j << "\n  ]\n}\n";
-    write_file_atomic(a.json, j.str());
+    write_file_atomic(a.json, j.dump(2) + "\n");
   }
   if (!a.plot.empty()) write_file_atomic(a.plot, svg_chart(scenes, variants, cells));
   return 0;

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,7 @@ struct BenchArgs {
   std::string size = "256x256";
   int ao = 16;
   int runs = 10, best = 3;
-  int threads = 0;
+  std::optional<int> threads;  // empty: all hardware threads
   double max_seconds = 60.0;
   std::string json, plot, markdown;
   bool list = false;

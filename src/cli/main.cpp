@@ -1,5 +1,6 @@
 // tracer: the command-line front end. Exit codes: 0 ok, 1 bad input, 2 bad usage, 130 interrupted.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -12,49 +13,87 @@
 #include "cli/bench.hpp"
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
+#include "cli/signals.hpp"
 #include "io/image_io.hpp"
 #include "base/errors.hpp"
 
 namespace tracer::cli {
 namespace {
 
-std::atomic<bool> g_interrupted{false};
-
-extern "C" void on_sigint(int) { g_interrupted.store(true); }
-
-void install_sigint_handler() {
-  struct sigaction sa {};
-  sa.sa_handler = on_sigint;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESETHAND;  // a second Ctrl-C kills at once
-  sigaction(SIGINT, &sa, nullptr);
-}
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The run's statistics, for --stats (text) and --stats-json.
+nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel, const SchedOptions& sched,
+                            const RenderArgs& args, double load_ms, double render_ms, const RayCounts& rays) {
+  const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
+  return {{"scene", scene.source},
+          {"triangles", scene.size()},
+          {"width", settings.width},
+          {"height", settings.height},
+          {"ao_samples", settings.ao_samples},
+          {"accel", accel.name},
+          {"packets", settings.packets},
+          {"sched", to_string(sched.kind)},
+          {"threads", sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads)},
+          {"load_ms", load_ms},
+          {"build_ms", accel.build_ms},
+          {"render_ms", render_ms},
+          {"rays", {{"primary", rays.primary}, {"shadow", rays.shadow}, {"ao", rays.ao}, {"total", rays.total()}}},
+          {"mrays_per_s", mrays},
+          {"accel_bytes", accel.memory_bytes()},
+          {"output", args.output}};
+}
+
+void print_stats(const nlohmann::json& j, const Accelerator& accel) {
+  const auto str = [&](const char* k) { return j[k].get<std::string>(); };
+  std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
+  std::printf("image        %dx%d, %d AO rays per hit -> %s\n", j["width"].get<int>(), j["height"].get<int>(), j["ao_samples"].get<int>(),
+              str("output").c_str());
+  std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
+              double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
+              j["packets"].get<bool>() ? (accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles" : ", AO rays in bundles") : "");
+  if (const std::optional<BvhStats> st = accel.bvh_stats()) {
+    std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st->nodes, st->leaves,
+                st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
+  }
+  std::printf("scheduler    %s, %d threads\n", str("sched").c_str(), j["threads"].get<int>());
+  std::printf("load         %10.2f ms\n", j["load_ms"].get<double>());
+  std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
+  std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
+  const auto& r = j["rays"];
+  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu total\n", r["primary"].get<unsigned long long>(),
+              r["shadow"].get<unsigned long long>(), r["ao"].get<unsigned long long>(), r["total"].get<unsigned long long>());
+  std::printf("throughput   %10.2f Mrays/s\n", j["mrays_per_s"].get<double>());
+}
+
 int cmd_render(const RenderArgs& args) {
-  // Installed first, so a Ctrl-C during loading or the build is not lost: the render then stops
-  // at its first tile.
-  install_sigint_handler();
+  // Installed first, so a signal during loading or the build is not lost: both poll the flag.
+  install_stop_handlers();
+  const CancelFlag cancel = &stop_requested();
   validate(args);
-  image_format_for(args.output, "-o");
-  check_writable(args.output);
-  if (!args.stats_json.empty()) check_writable(args.stats_json);
+  check_outputs(args);
+  const ThreadLimit thread_limit(args.threads.value_or(0));
+  if (args.threads && ThreadLimit::oversubscribed(*args.threads)) {
+    std::cerr << "tracer: warning: --threads " << *args.threads << " is more than this machine's hardware threads; all "
+              << *args.threads << " run, sharing them\n";
+  }
 
   const auto t_load = std::chrono::steady_clock::now();
-  const Scene scene = load_scene(args.scene);
+  const Scene scene = load_scene(args.scene, args.quiet, cancel);
   const double load_ms = ms_since(t_load);
   const CameraSpec camera = camera_for(scene, args);
   const RenderSettings settings = settings_for(args);
   const SchedOptions sched = sched_options_for(args);
-  const Accelerator accel = build_accelerator(scene, accel_options_for(args));
+  AccelOptions accel_options = accel_options_for(args);
+  accel_options.bvh.cancel = cancel;
+  const Accelerator accel = build_accelerator(scene, accel_options);
 
   Framebuffer fb(settings.width, settings.height);
   RenderContext ctx{&scene, Camera(camera, settings.width, settings.height), settings, &fb};
   RenderControl control;
-  control.cancel = &g_interrupted;
+  control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
   bool finished;
   {
@@ -63,54 +102,27 @@ int cmd_render(const RenderArgs& args) {
   }
   const double render_ms = ms_since(t_render);
   if (!finished) {
-    if (args.save_partial) {
+    if (args.save_partial && control.pixels_done.load() > 0) {
       write_image(args.output, tonemap(fb, settings.exposure));
-      std::cerr << "tracer: interrupted; partial image written to " << args.output << "\n";
+      std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << args.output << "\n";
     } else {
-      std::cerr << "tracer: interrupted; no image written\n";
+      std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "") << "; no image written\n";
     }
-    return 130;
+    return exit_code_for_stop();
   }
   write_image(args.output, tonemap(fb, settings.exposure));
-
-  const RayCounts rays = control.counts.load();
-  const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
-  if (args.stats) {
-    std::printf("scene        %s (%zu triangles)\n", scene.source.c_str(), scene.size());
-    std::printf("image        %dx%d, %d AO rays per hit -> %s\n", settings.width, settings.height, settings.ao_samples, args.output.c_str());
-    std::printf("accelerator  %s, %.1f bytes/triangle%s\n", accel.name.c_str(), double(accel.memory_bytes()) / double(scene.size()),
-                !settings.packets ? "" : std::holds_alternative<WideBvh>(*accel.impl) ? ", primary rays in 4x4 packets, AO rays in bundles" : ", AO rays in bundles");
-    if (const auto* bvh = std::get_if<Bvh>(accel.impl.get())) {
-      const BvhStats st = bvh->stats();
-      std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st.nodes, st.leaves,
-                  st.avg_leaf_size, st.max_leaf_size, st.max_depth, st.sah_cost);
-    }
-    std::printf("scheduler    %s, %d threads\n", to_string(sched.kind).c_str(), sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads));
-    std::printf("load         %10.2f ms\n", load_ms);
-    std::printf("build        %10.2f ms\n", accel.build_ms);
-    std::printf("render       %10.2f ms\n", render_ms);
-    std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu total\n", (unsigned long long)rays.primary,
-                (unsigned long long)rays.shadow, (unsigned long long)rays.ao, (unsigned long long)rays.total());
-    std::printf("throughput   %10.2f Mrays/s\n", mrays);
+  if (stop_signal() != 0) {  // arrived during the final write, which is never torn
+    std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output << "\n";
+    return exit_code_for_stop();
   }
-  if (!args.stats_json.empty()) {
-    std::ostringstream j;
-    j << "{\n  \"scene\": \"" << scene.source << "\",\n  \"triangles\": " << scene.size()
-      << ",\n  \"width\": " << settings.width << ",\n  \"height\": " << settings.height
-      << ",\n  \"ao_samples\": " << settings.ao_samples << ",\n  \"accel\": \"" << accel.name
-      << "\",\n  \"packets\": " << (settings.packets ? "true" : "false") << ",\n  \"sched\": \"" << to_string(sched.kind) << "\",\n  \"threads\": "
-      << (sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads))
-      << ",\n  \"load_ms\": " << load_ms << ",\n  \"build_ms\": " << accel.build_ms << ",\n  \"render_ms\": " << render_ms
-      << ",\n  \"rays\": {\"primary\": " << rays.primary << ", \"shadow\": " << rays.shadow << ", \"ao\": " << rays.ao
-      << ", \"total\": " << rays.total() << "},\n  \"mrays_per_s\": " << mrays
-      << ",\n  \"accel_bytes\": " << accel.memory_bytes() << "\n}\n";
-    write_file_atomic(args.stats_json, j.str());
-  }
+  const nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
+  if (args.stats) print_stats(stats, accel);
+  if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
   return 0;
 }
 
 int cmd_info(const SceneArgs& args) {
-  const Scene scene = load_scene(args);
+  const Scene scene = load_scene(args, false);
   std::printf("scene       %s\n", scene.source.c_str());
   std::printf("triangles   %zu (%zu degenerate)\n", scene.size(), scene.degenerate_count);
   std::printf("vertices    %zu\n", scene.vertex_count);
@@ -180,6 +192,9 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::cerr << "tracer: error: " << e.what() << "\n";
     return 1;
+  } catch (const Cancelled&) {
+    std::cerr << "tracer: " << stop_signal_name() << "; no image written\n";
+    return exit_code_for_stop();
   } catch (const std::bad_alloc&) {
     std::cerr << "tracer: error: out of memory\n";
     return 1;

@@ -29,6 +29,43 @@ Vec3 parse_vec3(const std::string& flag, const std::string& text) {
   return {v[0], v[1], v[2]};
 }
 
+Vec3 parse_point(const std::string& flag, const std::string& text) {
+  const Vec3 p = parse_vec3(flag, text);
+  for (const float c : {p.x, p.y, p.z}) {
+    if (std::fabs(c) > kMaxCoordinate) throw UsageError(flag + ": coordinates must lie within +-1e18, got '" + text + "'");
+  }
+  return p;
+}
+
+std::pair<int, int> parse_size(const std::string& flag, const std::string& text) {
+  const size_t x = text.find('x');
+  int v[2] = {0, 0};
+  const std::string parts[2] = {text.substr(0, x), x == std::string::npos ? "" : text.substr(x + 1)};
+  for (int i = 0; i < 2; ++i) {
+    const char* b = parts[i].data();
+    const char* e = b + parts[i].size();
+    long long n = 0;
+    const auto [ptr, ec] = std::from_chars(b, e, n);
+    if (parts[i].empty() || ec != std::errc{} || ptr != e) throw UsageError(flag + ": expected WxH (two whole numbers), got '" + text + "'");
+    check_range(flag + (i == 0 ? " width" : " height"), n, 1, 16384);
+    v[i] = int(n);
+  }
+  return {v[0], v[1]};
+}
+
+std::vector<std::string> split_list(const std::string& flag, const std::string& text) {
+  std::vector<std::string> items;
+  size_t pos = 0;
+  for (;;) {
+    const size_t comma = text.find(',', pos);
+    std::string item = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    if (item.empty()) throw UsageError(flag + ": empty name in '" + text + "'");
+    items.push_back(std::move(item));
+    if (comma == std::string::npos) return items;
+    pos = comma + 1;
+  }
+}
+
 void check_range(const std::string& flag, long long value, long long lo, long long hi) {
   if (value < lo || value > hi) {
     throw UsageError(flag + ": must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + std::to_string(value));

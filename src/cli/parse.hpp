@@ -2,12 +2,20 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "math/vec.hpp"
 
 namespace tracer::cli {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text);
+// "WxH", each 1-16384.
+std::pair<int, int> parse_size(const std::string& flag, const std::string& text);
+// A comma-separated list with no empty item.
+std::vector<std::string> split_list(const std::string& flag, const std::string& text);
+// A position (--eye, --look, --light): three finite numbers within the supported coordinate range.
+Vec3 parse_point(const std::string& flag, const std::string& text);
 void check_range(const std::string& flag, long long value, long long lo, long long hi);
 void check_range_real(const std::string& flag, double value, double lo, double hi, bool lo_open = false);
 

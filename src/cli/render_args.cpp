@@ -1,12 +1,19 @@
 #include "cli/render_args.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
 #include "cli/parse.hpp"
+#include "io/image_io.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 
 namespace tracer::cli {
+
+namespace fs = std::filesystem;
 
 void add_scene_options(CLI::App& app, SceneArgs& a) {
   app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)");
@@ -70,12 +77,12 @@ void validate(const RenderArgs& a) {
   check_range("--max-leaf", a.max_leaf, 1, 16);
   check_range("--bins", a.bins, 4, 32);
   check_range_real("--traversal-cost", a.traversal_cost, 0.0, 100.0, true);
-  if (!a.eye.empty()) parse_vec3("--eye", a.eye);
-  if (!a.look.empty()) parse_vec3("--look", a.look);
+  if (!a.eye.empty()) parse_point("--eye", a.eye);
+  if (!a.look.empty()) parse_point("--look", a.look);
   if (!a.up.empty()) {
     if (length(parse_vec3("--up", a.up)) == 0.0f) throw UsageError("--up: must not be the zero vector");
   }
-  for (const auto& l : a.scene.lights) parse_vec3("--light", l);
+  for (const auto& l : a.scene.lights) parse_point("--light", l);
   const AccelOptions accel = accel_options_for(a);
   if (a.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh) {
     throw UsageError("--packets: needs --accel bvh or bvh8 (the accelerators with packet kernels)");
@@ -86,14 +93,36 @@ void validate(const RenderArgs& a) {
   }
 }
 
-Scene load_scene(const SceneArgs& a) {
-  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene);
+// Two paths name the same file: the same inode if both exist, else the same absolute path.
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  return fs::weakly_canonical(fs::absolute(a), ec) == fs::weakly_canonical(fs::absolute(b), ec);
+}
+
+void check_outputs(const RenderArgs& a) {
+  image_format_for(a.output, "-o");
+  if (!a.scene.scene.empty() && a.scene.scene != "-" && same_file(a.output, a.scene.scene)) {
+    throw UsageError("-o: '" + a.output + "' is the input scene");
+  }
+  check_writable(a.output);
+  if (a.stats_json.empty()) return;
+  if (!a.scene.scene.empty() && a.scene.scene != "-" && same_file(a.stats_json, a.scene.scene)) {
+    throw UsageError("--stats-json: '" + a.stats_json + "' is the input scene");
+  }
+  if (same_file(a.stats_json, a.output)) throw UsageError("--stats-json: '" + a.stats_json + "' is also the -o image");
+  check_writable(a.stats_json);
+}
+
+Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
+  const WarningSink silent = [](const std::string&) {};
+  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, quiet ? silent : WarningSink{}, cancel);
   if (a.no_scene_lights) scene.lights.clear();
   const float diag = length(scene.bounds.extent());
   const float intensity = a.light_intensity ? float(*a.light_intensity) : 0.25f * diag * diag;
   for (const std::string& text : a.lights) {
     Light l;
-    l.position = parse_vec3("--light", text);
+    l.position = parse_point("--light", text);
     l.power = Vec3{intensity};
     scene.lights.push_back(l);
   }
@@ -102,13 +131,21 @@ Scene load_scene(const SceneArgs& a) {
 
 CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
   const float fov = a.fov ? float(*a.fov) : kDefaultFovDegrees;
+  const Vec3 extent = scene.bounds.extent();
+  if (a.eye.empty() && a.look.empty() && !scene.camera && std::max({extent.x, extent.y, extent.z}) == 0.0f) {
+    throw InputError(scene.source + ": all vertices coincide, so there is nothing to frame (every triangle is degenerate)");
+  }
   CameraSpec spec = scene.camera && a.eye.empty() && a.look.empty() && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
   if (!a.eye.empty()) {
-    spec.eye = parse_vec3("--eye", a.eye);
+    spec.eye = parse_point("--eye", a.eye);
     if (a.look.empty()) spec.look = scene.bounds.center();
   }
-  if (!a.look.empty()) spec.look = parse_vec3("--look", a.look);
-  if (!a.up.empty()) spec.up = parse_vec3("--up", a.up);
+  if (!a.look.empty()) spec.look = parse_point("--look", a.look);
+  if (!a.up.empty()) {
+    // Scaled first, so a huge but valid --up cannot overflow the cross products below.
+    const Vec3 up = parse_vec3("--up", a.up);
+    spec.up = up * (1.0f / std::max({std::fabs(up.x), std::fabs(up.y), std::fabs(up.z)}));
+  }
   const Vec3 forward = spec.look - spec.eye;
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");

@@ -50,7 +50,10 @@ void add_scene_options(CLI::App& app, SceneArgs& args);
 void add_render_options(CLI::App& app, RenderArgs& args);
 
 // Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.
-Scene load_scene(const SceneArgs& args);
+// "-" reads the OBJ from standard input. `quiet` drops the loader's warnings.
+Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr);
+// -o and --stats-json: known formats, writable, and neither of them the input scene or each other.
+void check_outputs(const RenderArgs& args);
 CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 RenderSettings settings_for(const RenderArgs& args);
 AccelOptions accel_options_for(const RenderArgs& args);

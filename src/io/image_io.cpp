@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -16,6 +17,26 @@
 namespace tracer {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The temporary file of the atomic write in progress, for remove_pending_temp_file(), which a
+// signal handler may call: a fixed buffer and an atomic flag, nothing that allocates or locks.
+char g_pending_temp[4096];
+std::atomic<bool> g_pending{false};
+
+class PendingTemp {
+ public:
+  explicit PendingTemp(const std::string& path) {
+    if (path.size() < sizeof g_pending_temp) {
+      std::memcpy(g_pending_temp, path.c_str(), path.size() + 1);
+      g_pending.store(true);
+    }
+  }
+  ~PendingTemp() { g_pending.store(false); }
+};
+
+}  // namespace
 
 ImageFormat image_format_for(const std::string& path, const std::string& flag) {
   std::string ext = fs::path(path).extension().string();
@@ -39,6 +60,7 @@ void write_file_atomic(const std::string& path, std::string_view bytes) {
   std::string tmp = path + ".tmp-XXXXXX";
   const int fd = ::mkstemp(tmp.data());
   if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  const PendingTemp pending(tmp);
   ::fchmod(fd, 0644);
   size_t written = 0;
   while (written < bytes.size()) {
@@ -71,6 +93,10 @@ void write_image(const std::string& path, const Image8& image) {
     }
   }
   write_file_atomic(path, bytes);
+}
+
+void remove_pending_temp_file() {
+  if (g_pending.load()) ::unlink(g_pending_temp);
 }
 
 Image8 read_image(const std::string& path) {

@@ -20,6 +20,10 @@ void write_image(const std::string& path, const Image8& image);
 // Writes bytes to path via temp file + rename; throws InputError on failure.
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
+// Removes the temporary file of a write_file_atomic() in progress, if any. Async-signal-safe: for a
+// signal handler that ends the process in the middle of a write.
+void remove_pending_temp_file();
+
 // Checks up front that `path`'s directory exists and is writable, so a long render does not end
 // in an unwritable path; throws InputError.
 void check_writable(const std::string& path);

@@ -1,0 +1,46 @@
+#include "cli/signals.hpp"
+
+#include <unistd.h>
+
+#include <csignal>
+
+#include "io/image_io.hpp"
+
+namespace tracer::cli {
+namespace {
+
+std::atomic<bool> g_stop{false};
+std::atomic<int> g_signal{0};
+
+extern "C" void on_stop_signal(int sig) {
+  int expected = 0;
+  if (!g_signal.compare_exchange_strong(expected, sig)) {
+    remove_pending_temp_file();  // async-signal-safe: one unlink()
+    ::_exit(128 + expected);
+  }
+  g_stop.store(true);
+}
+
+}  // namespace
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking read returns, and the loader sees the flag
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+}
+
+const std::atomic<bool>& stop_requested() { return g_stop; }
+int stop_signal() { return g_signal.load(); }
+int exit_code_for_stop() { return 128 + stop_signal(); }
+
+const char* stop_signal_name() {
+  switch (stop_signal()) {
+    case SIGTERM: return "terminated";
+    case SIGHUP: return "hung up";
+    default: return "interrupted";
+  }
+}
+
+}  // namespace tracer::cli
