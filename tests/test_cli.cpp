@@ -163,6 +163,19 @@ TEST_F(Cli, MoreThreadsThanCoresRunAsAskedWithOurWarning) {
   }
 }
 
+TEST_F(Cli, OneAllowedCoreRunsOneThreadWithoutWarnings) {
+  // Under taskset the default thread count follows the affinity mask, not the machine's cores.
+  const std::string cmd = "taskset -c 0 " + std::string(TRACER_EXE) + " render -q --width 16 --height 16 --ao 1 --stats -o " + dir_ + "/t.png 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[4096];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, n);
+  ASSERT_EQ(::pclose(pipe), 0) << out;
+  EXPECT_EQ(out.find("Warning"), std::string::npos) << out;
+  EXPECT_NE(out.find("tbb, 1 threads"), std::string::npos) << out;
+}
+
 TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {
   const std::string ref = dir_ + "/ref.png";
   ASSERT_EQ(test::run_tracer("render " + dir_ + "/ok.obj -q --width 16 --height 16 -o " + ref).exit_code, 0);

@@ -2,16 +2,18 @@
 #pragma once
 
 #include <tbb/global_control.h>
+#include <tbb/info.h>
 
 #include <algorithm>
 #include <memory>
-#include <thread>
 
 namespace tracer {
 
-// 0 (or less): all hardware threads.
+// 0 (or less): every hardware thread this process may run on. oneTBB's count honours the CPU
+// affinity mask (taskset, cgroups), which std::thread::hardware_concurrency() does not: asking
+// oneTBB for more than that made it print a warning and run fewer.
 inline int resolve_thread_count(int threads) {
-  return threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return threads > 0 ? threads : std::max(1, tbb::info::default_concurrency());
 }
 
 // oneTBB caps every arena at the hardware thread count unless told otherwise, and says so on
@@ -22,7 +24,7 @@ class ThreadLimit {
   explicit ThreadLimit(int threads)
       : control_(threads > 0 ? std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads))
                              : nullptr) {}
-  // True when more threads were asked for than the machine has: they time-share its cores.
+  // True when more threads were asked for than the process may use: they time-share its cores.
   static bool oversubscribed(int threads) { return threads > resolve_thread_count(0); }
 
  private:
