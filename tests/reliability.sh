@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# Every bad input, signal and path case of docs/RELIABILITY.md, run against a tracer binary: the
+# exit code, the first line tracer prints on stderr, and what is left in the output directory.
+#   tests/reliability.sh TRACER             print the table (Markdown)
+#   tests/reliability.sh TRACER --check DOC fail unless every case gives the exit code DOC states
+#                                           and DOC's table is exactly what this run printed
+set -uo pipefail
+tracer=$(realpath "$1")
+mode=${2:-}
+doc=${3:+$(realpath "$3")}
+work=$(mktemp -d)
+chmod 755 "$work"  # the unprivileged case must reach its file
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+
+printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > ok.obj
+printf '# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n' > cr.obj
+printf 'v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n' > nan.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n' > range.obj
+printf '# nothing\n' > empty.obj
+printf 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n' > same.obj
+printf 'v 0 0 0\nv 1\001 0 0\nv 0 1 0\nf 1 2 3\n' > control.obj
+printf '\357\273\277v 0 0 0\nv +1 0 1e-50\nv 0 1 0\nf 1 2 3\n' > bom.obj
+{ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n'; for i in $(seq 20000); do printf 'usemtl undefined%d\nf 1 2 3\n' "$i"; done; } > materials.obj
+{
+  for i in $(seq 0 1999); do echo "v $((i % 50)) $((i / 50)) 0"; done
+  for i in $(seq 1 1949); do echo "f $i $((i + 1)) $((i + 50))"; done
+} > slow.obj
+ln -s loop-b loop-a
+ln -s loop-a loop-b
+mkdir scenes.d
+cp ok.obj locked.obj
+chmod 000 locked.obj
+mkfifo fifo.obj
+mkfifo silent.obj
+
+inputs=$(ls)
+as_user=()
+[[ $(id -u) -eq 0 ]] && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
+
+# case | command (run by bash in the work directory) | expected exit code
+cases=(
+  "missing scene|tracer render nowhere.obj -q|1"
+  "scene is a directory|tracer render scenes.d -q|1"
+  "scene is a symlink loop|tracer render loop-a -q|1"
+  "scene not readable (as an unprivileged user)|USER tracer render locked.obj -q -o /tmp/x.png|1"
+  "lone CR ends a comment, next line has 1e39|tracer render cr.obj -q --accel embree|1"
+  "NaN coordinate|tracer render nan.obj -q|1"
+  "face index out of range|tracer render range.obj -q|1"
+  "no triangles|tracer render empty.obj -q|1"
+  "all vertices coincide, no camera flags|tracer render same.obj -q|1"
+  "control character in a number|tracer render control.obj -q|1"
+  "UTF-8 byte-order mark, +1, 1e-50|tracer render bom.obj -q --width 32 --height 32|0"
+  "20,000 undefined material names|tracer render materials.obj --width 32 --height 32 -o m.png|0"
+  "scene from standard input (-)|tracer render - -q --width 32 --height 32 -o stdin.png < ok.obj|0"
+  "scene from a pipe|tracer render <(cat ok.obj) -q --width 32 --height 32 -o pipe.png|0"
+  "scene from a FIFO|(cat ok.obj > fifo.obj &) ; tracer render fifo.obj -q --width 32 --height 32 -o fifo.png|0"
+  "camera beyond +-1e18|tracer render --eye 0,1,1e19 --look 0,1,0 -q|2"
+  "--stats-json is the scene|tracer render ok.obj -q --stats-json ok.obj|2"
+  "--stats-json is the -o image|tracer render ok.obj -q -o a.png --stats-json ./a.png|2"
+  "-o in a missing directory|tracer render ok.obj -q -o no/such/dir.png|1"
+  "-o with an unknown extension|tracer render ok.obj -q -o out.jpg|2"
+  "--threads 0|tracer render --threads 0 -q|2"
+  "one allowed core (taskset -c 0), default threads|taskset -c 0 tracer render -q --width 32 --height 32 -o t.png|0"
+  "--threads 64 on a smaller machine|tracer render --threads 64 -q --width 32 --height 32 -o t.png|0"
+  "bench --variants ''|tracer bench --variants ''|2"
+  "bench --scenes ,|tracer bench --scenes ,|2"
+  "bench --size 32x32x99junk|tracer bench --size 32x32x99junk|2"
+  "bench --size 99999999999x2|tracer bench --size 99999999999x2|2"
+  "bench --threads 0|tracer bench --threads 0|2"
+  "Ctrl-C (SIGINT) while rendering|timeout --foreground --preserve-status -s INT 1 tracer $SLOW|130"
+  "Ctrl-C with --save-partial|timeout --foreground --preserve-status -s INT 1 tracer $SLOW --save-partial|130"
+  "SIGTERM while rendering|timeout --foreground --preserve-status -s TERM 1 tracer $SLOW|143"
+  "SIGHUP while rendering|timeout --foreground --preserve-status -s HUP 1 tracer $SLOW|129"
+  "Ctrl-C while the scene is still arriving, --save-partial|(sleep 5 > silent.obj &) ; timeout --foreground --preserve-status -s INT 1 tracer render silent.obj -q --save-partial -o out.png|130"
+  "kill -9 while rendering|timeout --foreground --preserve-status -s KILL 1 tracer $SLOW|137"
+)
+
+table=$'| case | command | exit | first line on stderr | left in the directory |\n|---|---|---:|---|---|\n'
+failures=0
+for c in "${cases[@]}"; do
+  IFS='|' read -r name cmd expected <<< "$c"
+  run=${cmd//tracer /\"\$tracer\" }
+  run=${run//USER /\"\$\{as_user[@]\}\" }
+  stderr=$(tracer=$tracer bash -c "as_user=(${as_user[*]}); $run" 2>&1 >/dev/null)
+  code=$?
+  first=$(printf '%s\n' "$stderr" | head -n 1)
+  [[ -z $first ]] && first="(nothing)"
+  left=$(comm -13 <(echo "$inputs") <(ls) | tr '\n' ' ')
+  left=${left% }
+  [[ -z $left ]] && left="nothing new"
+  [[ $left == *.tmp-* ]] && left="$left (a temporary file)"
+  shown=${cmd//USER /}
+  table+="| $name | \`${shown//|/\\|}\` | $code | ${first//|/\\|} | $left |"$'\n'
+  if [[ $code != "$expected" ]]; then
+    echo "reliability: '$name' exited $code, expected $expected: $first" >&2
+    failures=$((failures + 1))
+  fi
+  find . -maxdepth 1 -newer ok.obj -type f ! -name '*.obj' -delete
+  rm -rf no
+done
+
+if [[ $mode == --check ]]; then
+  expected_table=$(sed -n '/^| case |/,/^$/p' "$doc")
+  if [[ "$expected_table" != "${table%$'\n'}" ]]; then
+    echo "reliability: $doc differs from this run (regenerate it with tests/reliability.sh):" >&2
+    diff <(echo "$expected_table") <(echo "${table%$'\n'}") >&2
+    failures=$((failures + 1))
+  fi
+  echo "reliability: $(( ${#cases[@]} - failures )) passed, $failures failed"
+  exit $((failures > 0))
+fi
+printf '%s' "$table"
+exit $((failures > 0))
