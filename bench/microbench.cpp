@@ -65,7 +65,8 @@ std::vector<AoBundle> ao_bundles(const RecordedRays& r) {
     b.rays.tnear = r.ao[i].tnear;
     b.rays.tfar = r.ao[i].tfar;
     b.origin = r.ao_from[i];
-    for (int k = 0; k < kPacketSize && i < r.ao.size() && r.ao[i].org == b.rays.org && r.ao_from[i] == b.origin; ++k, ++i) {
+    for (int k = 0; k < kPacketSize && i < r.ao.size() && r.ao[i].org == b.rays.org && r.ao_from[i] == b.origin;
+         ++k, ++i) {
       b.rays.set_direction(k, r.ao[i].dir);
     }
     out.push_back(b);
@@ -95,9 +96,12 @@ std::vector<SceneCase>& cases() {
     };
     add("builtin-spheres", make_cornell_box(20000));
     const std::string dir = TRACER_SCENES_DIR;
-    for (const auto& [name, path] : {std::pair{"Original", "/cornell-box/CornellBox-Original.obj"}, {"Sphere", "/cornell-box/CornellBox-Sphere.obj"},
+    for (const auto& [name, path] : {std::pair{"Original", "/cornell-box/CornellBox-Original.obj"},
+                                     {"Sphere", "/cornell-box/CornellBox-Sphere.obj"},
                                      {"Water", "/cornell-box/CornellBox-Water.obj"},
-                                     {"Sponza", "/sponza/sponza.obj"}, {"Sibenik", "/sibenik/sibenik.obj"}, {"Bunny", "/bunny/bunny.obj"}}) {
+                                     {"Sponza", "/sponza/sponza.obj"},
+                                     {"Sibenik", "/sibenik/sibenik.obj"},
+                                     {"Bunny", "/bunny/bunny.obj"}}) {
       if (std::filesystem::exists(dir + path)) add(name, load_obj(dir + path, [](const std::string&) {}));
     }
     return v;
@@ -140,27 +144,39 @@ void register_dynamic() {
     for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
       for (BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
         static const char* modes[] = {"seq", "async", "queue", "tasks"};
-        const std::string name = std::string("BM_BvhBuild/") + c.name + "/" + (split == BvhSplit::Sah ? "sah/" : "median/") + modes[int(mode)];
-        benchmark::RegisterBenchmark(name.c_str(), [&c, split, mode](benchmark::State& st) {
-          BvhBuildOptions o;
-          o.split = split;
-          o.mode = mode;
-          size_t bytes = 0;
-          for (auto _ : st) {
-            const Bvh bvh(*c.scene, o);
-            bytes = bvh.memory_bytes();
-            benchmark::DoNotOptimize(bvh.nodes().data());
-          }
-          st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-          st.counters["bytes/tri"] = double(bytes) / double(c.scene->size());
-        })->Unit(benchmark::kMillisecond)->UseRealTime();
+        const std::string name = std::string("BM_BvhBuild/") + c.name + "/" +
+                                 (split == BvhSplit::Sah ? "sah/" : "median/") + modes[int(mode)];
+        benchmark::RegisterBenchmark(name.c_str(),
+                                     [&c, split, mode](benchmark::State& st) {
+                                       BvhBuildOptions o;
+                                       o.split = split;
+                                       o.mode = mode;
+                                       size_t bytes = 0;
+                                       for (auto _ : st) {
+                                         const Bvh bvh(*c.scene, o);
+                                         bytes = bvh.memory_bytes();
+                                         benchmark::DoNotOptimize(bvh.nodes().data());
+                                       }
+                                       st.counters["Mtris/s"] =
+                                           benchmark::Counter(double(c.scene->size()) * 1e-6,
+                                                              benchmark::Counter::kIsIterationInvariantRate);
+                                       st.counters["bytes/tri"] = double(bytes) / double(c.scene->size());
+                                     })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
       }
     }
     if (embree_available()) {
-      benchmark::RegisterBenchmark((std::string("BM_BvhBuild/") + c.name + "/embree").c_str(), [&c](benchmark::State& st) {
-        for (auto _ : st) benchmark::DoNotOptimize(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}).impl.get());
-        st.counters["Mtris/s"] = benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
-      })->Unit(benchmark::kMillisecond)->UseRealTime();
+      benchmark::RegisterBenchmark(
+          (std::string("BM_BvhBuild/") + c.name + "/embree").c_str(),
+          [&c](benchmark::State& st) {
+            for (auto _ : st)
+              benchmark::DoNotOptimize(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}).impl.get());
+            st.counters["Mtris/s"] =
+                benchmark::Counter(double(c.scene->size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+          })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
     }
     {
       // Primary rays of a 1024x1024 image (the renderer's default size, so the packets are as
@@ -183,7 +199,8 @@ void register_dynamic() {
         }
       }
       const double mrays = double(singles->size()) * 1e-6;
-      benchmark::RegisterBenchmark(("BM_Primary1024/" + c.name + "/bvh8-packets").c_str(), [wide, packets, mrays](benchmark::State& st) {
+      benchmark::RegisterBenchmark(("BM_Primary1024/" + c.name + "/bvh8-packets").c_str(), [wide, packets, mrays](
+                                                                                               benchmark::State& st) {
         const WideBvh& w = std::get<WideBvh>(*wide->impl);
         Hit hits[kPacketSize];
         size_t n = 0;
@@ -203,20 +220,25 @@ void register_dynamic() {
       const Named singles_on[] = {
           {"bvh-sah", std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{}))},
           {"bvh8", wide},
-          {"embree", embree_available() ? std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree})) : nullptr}};
+          {"embree", embree_available() ? std::make_shared<Accelerator>(
+                                              build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}))
+                                        : nullptr}};
       for (const auto& [accel_name, accel] : singles_on) {
         if (!accel) continue;
-        benchmark::RegisterBenchmark(("BM_Primary1024/" + c.name + "/" + accel_name).c_str(), [accel = accel, singles, mrays](benchmark::State& st) {
-          size_t n = 0;
-          accel->visit([&](const auto& a) {
-            Hit h;
-            for (auto _ : st) {
-              for (const Ray& r : *singles) n += a.intersect(r, h);
-            }
-          });
-          benchmark::DoNotOptimize(n);
-          st.counters["Mrays/s"] = benchmark::Counter(mrays, benchmark::Counter::kIsIterationInvariantRate);
-        })->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("BM_Primary1024/" + c.name + "/" + accel_name).c_str(),
+                                     [accel = accel, singles, mrays](benchmark::State& st) {
+                                       size_t n = 0;
+                                       accel->visit([&](const auto& a) {
+                                         Hit h;
+                                         for (auto _ : st) {
+                                           for (const Ray& r : *singles) n += a.intersect(r, h);
+                                         }
+                                       });
+                                       benchmark::DoNotOptimize(n);
+                                       st.counters["Mrays/s"] =
+                                           benchmark::Counter(mrays, benchmark::Counter::kIsIterationInvariantRate);
+                                     })
+            ->Unit(benchmark::kMillisecond);
       }
     }
     std::vector<std::pair<std::string, AccelOptions>> accels = {{"bvh-sah", AccelOptions{}}};
@@ -237,14 +259,16 @@ void register_dynamic() {
         const std::vector<Ray>* rays = kind == 0 ? &c.rays.primary : (kind == 1 ? &c.rays.shadow : &c.rays.ao);
         const std::vector<uint32_t>* from = kind == 1 ? &c.rays.shadow_from : &c.rays.ao_from;
         if (rays->empty()) continue;
-        auto bundles = std::make_shared<std::vector<AoBundle>>(kind == 4 ? ao_bundles(c.rays) : std::vector<AoBundle>{});
+        auto bundles =
+            std::make_shared<std::vector<AoBundle>>(kind == 4 ? ao_bundles(c.rays) : std::vector<AoBundle>{});
         // The rays (or bundles) [begin, end) through `a`, as the renderer asks for them.
         const auto trace = [rays, from, kind, bundles](const auto& a, size_t begin, size_t end) {
           size_t n = 0;
           Hit h;
           if constexpr (BundleAccelerator<std::decay_t<decltype(a)>>) {
             if (kind == 4) {
-              for (size_t i = begin; i < end; ++i) n += size_t(std::popcount(a.occluded_bundle_from((*bundles)[i].rays, (*bundles)[i].origin)));
+              for (size_t i = begin; i < end; ++i)
+                n += size_t(std::popcount(a.occluded_bundle_from((*bundles)[i].rays, (*bundles)[i].origin)));
               return n;
             }
           }
@@ -258,8 +282,10 @@ void register_dynamic() {
         const double mrays = double(rays->size()) * 1e-6;
         // One thread, and two (the same rays split in chunks over a two-thread oneTBB arena).
         for (const int threads : {1, 2}) {
-          const std::string name = "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind] + (threads == 2 ? "/2threads" : "");
-          auto* b = benchmark::RegisterBenchmark(name.c_str(), [accel, trace, items, mrays, threads](benchmark::State& st) {
+          const std::string name =
+              "BM_Traverse/" + c.name + "/" + accel_name + "/" + kinds[kind] + (threads == 2 ? "/2threads" : "");
+          auto* b = benchmark::RegisterBenchmark(name.c_str(), [accel, trace, items, mrays,
+                                                                threads](benchmark::State& st) {
             std::atomic<size_t> n{0};
             tbb::task_arena arena(threads);
             accel->visit([&](const auto& a) {

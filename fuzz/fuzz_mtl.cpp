@@ -21,7 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const tracer::Scene scene = tracer::load_obj_from_string(obj, mtl, "fuzz.obj", [](const std::string&) {});
     for (const tracer::Material& m : scene.materials) {
-      if (!tracer::is_finite(m.kd) || !tracer::is_finite(m.ks) || !tracer::is_finite(m.ke) || !std::isfinite(m.ni)) std::abort();
+      if (!tracer::is_finite(m.kd) || !tracer::is_finite(m.ks) || !tracer::is_finite(m.ke) || !std::isfinite(m.ni))
+        std::abort();
     }
     for (uint32_t id : scene.tri_material) {
       if (id >= scene.materials.size()) std::abort();

@@ -37,7 +37,8 @@ Ray ray_from(const uint8_t* bytes, const Scene& scene) {
 }
 
 bool same(bool ha, const Hit& a, bool hb, const Hit& b) {
-  return ha == hb && (!ha || (a.tri == b.tri && a.t == b.t && a.u == b.u && a.v == b.v && a.geomID == b.geomID && a.primID == b.primID));
+  return ha == hb && (!ha || (a.tri == b.tri && a.t == b.t && a.u == b.u && a.v == b.v && a.geomID == b.geomID &&
+                              a.primID == b.primID));
 }
 
 }  // namespace
@@ -57,8 +58,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   median.bvh.split = BvhSplit::Median;
   wide.kind = AccelKind::Bvh8;
   simd.kind = AccelKind::BruteSimd;
-  const Accelerator accels[] = {build_accelerator(scene, sah), build_accelerator(scene, median), build_accelerator(scene, wide),
-                                build_accelerator(scene, simd)};
+  const Accelerator accels[] = {build_accelerator(scene, sah), build_accelerator(scene, median),
+                                build_accelerator(scene, wide), build_accelerator(scene, simd)};
   // Rays from the input's bytes, cycling over them; always a few, even from a short input.
   uint8_t window[24];
   for (size_t k = 0; k < 16; ++k) {

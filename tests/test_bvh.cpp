@@ -21,8 +21,14 @@ template <class Inner>
 struct RecordingAccel {
   const Inner* inner;
   mutable std::vector<Ray> closest, any;
-  bool intersect(const Ray& r, Hit& h) const { closest.push_back(r); return inner->intersect(r, h); }
-  bool occluded(const Ray& r) const { any.push_back(r); return inner->occluded(r); }
+  bool intersect(const Ray& r, Hit& h) const {
+    closest.push_back(r);
+    return inner->intersect(r, h);
+  }
+  bool occluded(const Ray& r) const {
+    any.push_back(r);
+    return inner->occluded(r);
+  }
 };
 
 struct RaySet {
@@ -42,7 +48,11 @@ RaySet rays_for(const Scene& scene, size_t random_count, int image) {
   s.width = s.height = image;
   s.ao_samples = 2;
   Framebuffer fb(image, image);
-  const CameraSpec cam = scene.camera ? *scene.camera : CameraSpec{scene.bounds.center() + Vec3{0, 0, length(scene.bounds.extent())}, scene.bounds.center(), {0, 1, 0}, 50.0f};
+  const CameraSpec cam = scene.camera ? *scene.camera
+                                      : CameraSpec{scene.bounds.center() + Vec3{0, 0, length(scene.bounds.extent())},
+                                                   scene.bounds.center(),
+                                                   {0, 1, 0},
+                                                   50.0f};
   RenderContext ctx{&scene, Camera(cam, image, image), s, &fb};
   render_tile(rec, ctx, Tile{0, 0, image, image});
   set.closest.insert(set.closest.end(), rec.closest.begin(), rec.closest.end());
@@ -62,7 +72,8 @@ Reference answers(const A& accel, const RaySet& rays) {
   ref.hits.resize(rays.closest.size());
   ref.occluded.resize(rays.any.size());
   tbb::parallel_for(size_t(0), rays.closest.size(), [&](size_t i) { accel.intersect(rays.closest[i], ref.hits[i]); });
-  tbb::parallel_for(size_t(0), rays.any.size(), [&](size_t i) { ref.occluded[i] = accel.occluded(rays.any[i]) ? 1 : 0; });
+  tbb::parallel_for(size_t(0), rays.any.size(),
+                    [&](size_t i) { ref.occluded[i] = accel.occluded(rays.any[i]) ? 1 : 0; });
   if constexpr (requires { accel.occluded_from(Ray{}, 0u); }) {
     // Its answer must not depend on the origin triangle: any triangle, a degenerate one, or an
     // index past the end (which falls back to the root) must all agree with occluded().
@@ -82,17 +93,20 @@ size_t compare(const Reference& expected, const Reference& got, const std::strin
   for (size_t i = 0; i < expected.hits.size(); ++i) {
     const Hit& e = expected.hits[i];
     const Hit& g = got.hits[i];
-    const bool same = e.valid() == g.valid() &&
-                      (!e.valid() || (e.primID == g.primID && e.geomID == g.geomID && std::fabs(e.t - g.t) <= 1e-5f * std::max(1.0f, e.t)));
+    const bool same = e.valid() == g.valid() && (!e.valid() || (e.primID == g.primID && e.geomID == g.geomID &&
+                                                                std::fabs(e.t - g.t) <= 1e-5f * std::max(1.0f, e.t)));
     if (!same && bad++ < 3) {
-      ADD_FAILURE() << what << ": ray " << i << " expected tri " << e.tri << " t " << e.t << ", got tri " << g.tri << " t " << g.t;
+      ADD_FAILURE() << what << ": ray " << i << " expected tri " << e.tri << " t " << e.t << ", got tri " << g.tri
+                    << " t " << g.t;
     }
   }
   for (size_t i = 0; i < expected.occluded.size(); ++i) {
-    if (expected.occluded[i] != got.occluded[i] && bad++ < 3) ADD_FAILURE() << what << ": occluded ray " << i << " differs";
+    if (expected.occluded[i] != got.occluded[i] && bad++ < 3)
+      ADD_FAILURE() << what << ": occluded ray " << i << " differs";
   }
   for (size_t i = 0; i < got.occluded_from.size(); ++i) {
-    if (expected.occluded[i] != got.occluded_from[i] && bad++ < 3) ADD_FAILURE() << what << ": occluded_from ray " << i << " differs";
+    if (expected.occluded[i] != got.occluded_from[i] && bad++ < 3)
+      ADD_FAILURE() << what << ": occluded_from ray " << i << " differs";
   }
   return bad;
 }
@@ -141,11 +155,12 @@ void check_scene_against_brute(const Scene& scene, size_t random_count, int imag
 TEST(BvhAgreement, CornellScenesMatchBruteForce) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
   // Every Cornell file in ../shared/scenes/cornell-box (the water surface alone too).
-  for (const char* name : {"CornellBox-Original", "CornellBox-Mirror", "CornellBox-Sphere", "CornellBox-Water", "CornellBox-Glossy",
-                           "CornellBox-Glossy-Floor", "CornellBox-Empty-CO", "CornellBox-Empty-RG", "CornellBox-Empty-Squashed",
-                           "CornellBox-Empty-White", "water"}) {
+  for (const char* name : {"CornellBox-Original", "CornellBox-Mirror", "CornellBox-Sphere", "CornellBox-Water",
+                           "CornellBox-Glossy", "CornellBox-Glossy-Floor", "CornellBox-Empty-CO", "CornellBox-Empty-RG",
+                           "CornellBox-Empty-Squashed", "CornellBox-Empty-White", "water"}) {
     SCOPED_TRACE(name);
-    const Scene scene = load_obj(test::scene_path(std::string("cornell-box/") + name + ".obj"), [](const std::string&) {});
+    const Scene scene =
+        load_obj(test::scene_path(std::string("cornell-box/") + name + ".obj"), [](const std::string&) {});
     check_scene_against_brute(scene, test::ray_budget(100'000), 32);
   }
 }
@@ -167,9 +182,11 @@ TEST(BvhAgreement, LargeScenesMatchBruteForce) {
 TEST(BvhAgreement, RenderedImagesMatchBruteForce) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
   for (const char* name : {"Original", "Sphere", "Water"}) {
-    const Scene scene = load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
+    const Scene scene =
+        load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
     const auto reference = render_small(BruteForce(scene), scene, 40).rgb;
-    for (const BvhBuildOptions& o : all_builds()) EXPECT_EQ(render_small(Bvh(scene, o), scene, 40).rgb, reference) << name << " " << describe(o);
+    for (const BvhBuildOptions& o : all_builds())
+      EXPECT_EQ(render_small(Bvh(scene, o), scene, 40).rgb, reference) << name << " " << describe(o);
   }
 }
 
@@ -200,7 +217,8 @@ TEST(BuildDeterminism, ParallelBuildersMatchSequentialTree) {
 
 TEST(BuildDeterminism, ParallelBuildersMatchOnSphereScene) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
-  expect_parallel_builds_match(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
+  expect_parallel_builds_match(
+      load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
 }
 
 TEST(BvhQuality, SahBeatsMedianAndStaysSmall) {
@@ -231,7 +249,8 @@ TEST(BvhDegenerate, AwkwardInputs) {
     same_centroid.push_back({u * 2.0f, v * 2.0f, -(u + v) * 2.0f});
     const float s = std::pow(10.0f, float(i % 30) - 15.0f);  // 1e-15 .. 1e14
     huge.push_back({{s, 0, 0}, {s * 2, 0, s}, {s, s, 0}});
-    zero_area.push_back(i % 2 ? Triangle{{f, 0, 0}, {f + 1, 1, 1}, {f + 2, 2, 2}} : Triangle{{f, 0, 0}, {f + 1, 0, 0}, {f, 1, 0}});
+    zero_area.push_back(i % 2 ? Triangle{{f, 0, 0}, {f + 1, 1, 1}, {f + 2, 2, 2}}
+                              : Triangle{{f, 0, 0}, {f + 1, 0, 0}, {f, 1, 0}});
   }
   inputs.push_back({"coplanar", coplanar});
   inputs.push_back({"same_centroid", same_centroid});
@@ -242,7 +261,8 @@ TEST(BvhDegenerate, AwkwardInputs) {
     const Scene scene = test::scene_of(tris);
     RaySet rays;
     rays.closest = tris.empty() ? std::vector<Ray>(10) : test::random_rays(scene, 5000, 3);
-    for (Ray& r : rays.closest) if (r.dir == Vec3{}) r.dir = {0, 0, 1};
+    for (Ray& r : rays.closest)
+      if (r.dir == Vec3{}) r.dir = {0, 0, 1};
     // Rays straight down onto the triangles as well, so there are hits to agree on.
     for (size_t i = 0; i < tris.size(); ++i) {
       Ray r;
@@ -264,7 +284,8 @@ TEST(BvhAgreement, EmbreeAgreesOnCornellScenes) {
   if (!embree_available() || !test::have_shared_scenes()) GTEST_SKIP() << "no Embree in this build";
   for (const char* name : {"Original", "Sphere", "Water"}) {
     SCOPED_TRACE(name);
-    const Scene scene = load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
+    const Scene scene =
+        load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {});
     const RaySet rays = rays_for(scene, test::ray_budget(100'000) / 4, 24);
     const Accelerator embree = build_accelerator(scene, AccelOptions{.kind = AccelKind::Embree});
     const Reference ours = answers(Bvh(scene, BvhBuildOptions{}), rays);

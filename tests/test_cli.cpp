@@ -94,8 +94,10 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
   };
   for (const CliCase& c : cases) {
     std::string args = c.args;
-    for (const auto& [key, file] : {std::pair{"NAN", "nan.obj"}, {"RANGE", "range.obj"}, {"EMPTY", "empty.obj"}, {"SAME", "same.obj"}}) {
-      for (size_t p = args.find(key); p != std::string::npos; p = args.find(key)) args.replace(p, std::string(key).size(), dir_ + "/" + file);
+    for (const auto& [key, file] :
+         {std::pair{"NAN", "nan.obj"}, {"RANGE", "range.obj"}, {"EMPTY", "empty.obj"}, {"SAME", "same.obj"}}) {
+      for (size_t p = args.find(key); p != std::string::npos; p = args.find(key))
+        args.replace(p, std::string(key).size(), dir_ + "/" + file);
     }
     if (args.rfind("render", 0) == 0) args += out;
     SCOPED_TRACE(args);
@@ -127,14 +129,17 @@ TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
   const std::string scene = dir_ + "/a\"b\\c.obj";
   fs::copy_file(dir_ + "/ok.obj", scene);
   const std::string quoted_scene = "'" + scene + "'";
-  auto r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " + quoted_scene);
+  auto r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " +
+                            quoted_scene);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("is the input scene"), std::string::npos) << r.output;
-  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " + dir_ + "/./x.png");
+  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 -o " + dir_ + "/x.png --stats-json " +
+                       dir_ + "/./x.png");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("is also the -o image"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
-  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 6 --ao 2 -o " + dir_ + "/x.png --stats-json " + dir_ + "/s.json");
+  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 6 --ao 2 -o " + dir_ +
+                       "/x.png --stats-json " + dir_ + "/s.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(dir_ + "/s.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -144,7 +149,8 @@ TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
 }
 
 TEST_F(Cli, BenchJsonParsesBack) {
-  const auto r = test::run_tracer("bench --scenes builtin --variants sah,bvh8 --size 8x8 --ao 1 --runs 1 --best 1 --json " + dir_ + "/b.json");
+  const auto r = test::run_tracer(
+      "bench --scenes builtin --variants sah,bvh8 --size 8x8 --ao 1 --runs 1 --best 1 --json " + dir_ + "/b.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(dir_ + "/b.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -165,7 +171,8 @@ TEST_F(Cli, MoreThreadsThanCoresRunAsAskedWithOurWarning) {
 
 TEST_F(Cli, OneAllowedCoreRunsOneThreadWithoutWarnings) {
   // Under taskset the default thread count follows the affinity mask, not the machine's cores.
-  const std::string cmd = "taskset -c 0 " + std::string(TRACER_EXE) + " render -q --width 16 --height 16 --ao 1 --stats -o " + dir_ + "/t.png 2>&1";
+  const std::string cmd = "taskset -c 0 " + std::string(TRACER_EXE) +
+                          " render -q --width 16 --height 16 --ao 1 --stats -o " + dir_ + "/t.png 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string out;
@@ -189,7 +196,8 @@ TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {
 
 TEST_F(Cli, RendersPngPpmAndStats) {
   const std::string scene = dir_ + "/ok.obj";
-  auto r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --stats --stats-json " + dir_ + "/s.json -o " + dir_ + "/a.png");
+  auto r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --stats --stats-json " + dir_ +
+                            "/s.json -o " + dir_ + "/a.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Mrays/s"), std::string::npos);
   const Image8 png = read_image(dir_ + "/a.png");
@@ -204,7 +212,8 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   const Image8 ppm = read_image(dir_ + "/a.ppm");
   EXPECT_EQ(ppm.rgb, png.rgb);  // same render, two containers
   // The 8-wide BVH with primary-ray packets: the same image, every primary ray counted once.
-  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --accel bvh8 --packets --stats-json " + dir_ + "/p.json -o " + dir_ + "/p.png");
+  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --accel bvh8 --packets --stats-json " +
+                       dir_ + "/p.json -o " + dir_ + "/p.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_image(dir_ + "/p.png").rgb, png.rgb);
   std::ifstream pjson(dir_ + "/p.json");
@@ -236,7 +245,8 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
   const std::string exe = TRACER_EXE;
   for (const bool partial : {false, true}) {
     const std::string out = dir_ + (partial ? "/partial.png" : "/none.png");
-    const std::string cmd = "timeout --foreground --preserve-status -s INT 1 " + exe + " render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out +
+    const std::string cmd = "timeout --foreground --preserve-status -s INT 1 " + exe + " render " + scene +
+                            " -q --accel brute --width 2048 --height 2048 -o " + out +
                             (partial ? " --save-partial" : "") + " 2>&1";
     const auto t0 = std::chrono::steady_clock::now();
     const int status = std::system(cmd.c_str());
@@ -250,12 +260,14 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
       EXPECT_EQ(img.width, 2048);
     }
   }
-  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
 }
 
 // Runs `args` under `timeout --foreground --preserve-status -s SIG 1`: one signal after a second.
 int run_signalled(const std::string& sig, const std::string& args) {
-  const std::string cmd = "timeout --foreground --preserve-status -s " + sig + " 1 " + std::string(TRACER_EXE) + " " + args + " 2>&1";
+  const std::string cmd =
+      "timeout --foreground --preserve-status -s " + sig + " 1 " + std::string(TRACER_EXE) + " " + args + " 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
@@ -273,7 +285,8 @@ TEST_F(Cli, TermAndHupStopLikeCtrlC) {
     EXPECT_EQ(run_signalled(sig, "render " + scene + " -q --accel brute --width 2048 --height 2048 -o " + out), code);
     EXPECT_FALSE(fs::exists(out));
   }
-  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
 }
 
 TEST_F(Cli, CtrlCWhileTheSceneIsStillArrivingStopsWithoutAnImage) {
@@ -284,8 +297,9 @@ TEST_F(Cli, CtrlCWhileTheSceneIsStillArrivingStopsWithoutAnImage) {
   {
     std::ofstream script(dir_ + "/run.sh");
     script << "sleep 30 > " << fifo << " & holder=$!\n"
-           << "timeout --foreground --preserve-status -s INT 1 " << TRACER_EXE << " render " << fifo << " -q --save-partial -o " << out
-           << " > " << dir_ << "/log.txt 2>&1\necho $? > " << dir_ << "/code.txt\nkill $holder\n";
+           << "timeout --foreground --preserve-status -s INT 1 " << TRACER_EXE << " render " << fifo
+           << " -q --save-partial -o " << out << " > " << dir_ << "/log.txt 2>&1\necho $? > " << dir_
+           << "/code.txt\nkill $holder\n";
   }
   ASSERT_EQ(std::system(("bash " + dir_ + "/run.sh").c_str()), 0);
   std::ifstream code(dir_ + "/code.txt");

@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "scene/builtin.hpp"
 #include "base/errors.hpp"
+#include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
@@ -29,14 +29,16 @@ TEST(Loader, StudyScenesHaveTheRightCounts) {
                             Expected{"CornellBox-Sphere.obj", 2188}, Expected{"CornellBox-Water.obj", 7088}}) {
     SCOPED_TRACE(e.file);
     std::vector<std::string> warnings;
-    const Scene s = load_obj(test::scene_path(std::string("cornell-box/") + e.file), [&](const std::string& w) { warnings.push_back(w); });
+    const Scene s = load_obj(test::scene_path(std::string("cornell-box/") + e.file),
+                             [&](const std::string& w) { warnings.push_back(w); });
     EXPECT_EQ(s.size(), e.triangles);
     EXPECT_EQ(s.tri_geom.size(), e.triangles);
     ASSERT_EQ(s.lights.size(), 1u);
     EXPECT_GT(s.lights[0].power.x, 0.0f);
     EXPECT_NEAR(s.lights[0].position.y, 1.98f, 0.42f);  // the lamp hangs just under the ceiling
     EXPECT_GE(s.materials.size(), 7u);
-    const auto light = std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "light"; });
+    const auto light =
+        std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "light"; });
     ASSERT_NE(light, s.materials.end());
     EXPECT_TRUE(light->emissive());
     EXPECT_EQ(s.degenerate_count, 0u);
@@ -51,7 +53,8 @@ TEST(Loader, StudyScenesHaveTheRightCounts) {
 TEST(Loader, OriginalMaterialsAreRead) {
   if (!test::have_shared_scenes()) GTEST_SKIP();
   const Scene s = load_obj(test::scene_path("cornell-box/CornellBox-Original.obj"));
-  const auto red = std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "leftWall"; });
+  const auto red =
+      std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "leftWall"; });
   ASSERT_NE(red, s.materials.end());
   EXPECT_FLOAT_EQ(red->kd.x, 0.63f);
   EXPECT_FLOAT_EQ(red->kd.y, 0.065f);
@@ -99,19 +102,23 @@ TEST(Loader, BadInputsGiveOneLineErrorsWithLine) {
       {"inf", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", "bad.obj:3: non-finite coordinate 'inf'"},
       {"short_vertex", "v 0 0\n", "bad.obj:1: 'v' needs 3 numbers, got 2"},
       {"garbage_number", "v 0 0 x1\n", "bad.obj:1: malformed number 'x1'"},
-      {"index_too_big", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "bad.obj:4: vertex index 4 out of range (3 defined so far)"},
+      {"index_too_big", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+       "bad.obj:4: vertex index 4 out of range (3 defined so far)"},
       {"index_zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "bad.obj:4: vertex index 0 out of range"},
       {"negative_too_far", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "bad.obj:4: vertex index -4 out of range"},
       {"forward_reference", "v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n", "bad.obj:2: vertex index 2 out of range"},
-      {"normal_out_of_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n", "bad.obj:5: normal index 2 out of range"},
+      {"normal_out_of_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+       "bad.obj:5: normal index 2 out of range"},
       {"two_corner_face", "v 0 0 0\nv 1 0 0\nf 1 2\n", "bad.obj:3: face needs at least 3 vertices, got 2"},
       {"bad_face_token", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a\n", "bad.obj:4: malformed face index 'a'"},
       {"no_triangles", "v 0 0 0\nv 1 0 0\n", "bad.obj: scene has no triangles"},
       {"empty_file", "", "bad.obj: scene has no triangles"},
       {"huge_number", "v 0 0 1e999\n", "bad.obj:1: number out of range '1e999'"},
-      {"beyond_supported_range", "v 0 0 1e19\n", "bad.obj:1: number out of range '1e19' (coordinates must lie within +-1e18)"},
+      {"beyond_supported_range", "v 0 0 1e19\n",
+       "bad.obj:1: number out of range '1e19' (coordinates must lie within +-1e18)"},
       // tinyobjloader ends a line at a lone CR: the vertex after it is a line of its own, checked.
-      {"cr_inside_comment", "# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n", "bad.obj:2: number out of range '1e39'"},
+      {"cr_inside_comment", "# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n",
+       "bad.obj:2: number out of range '1e39'"},
       {"cr_only_lines", "v 0 0 0\rv 1 0 0\rf 1 2 3\r", "bad.obj:3: vertex index 3 out of range (2 defined so far)"},
       {"control_character", "v 0 0 0\nv 1\x01 0 0\n", "bad.obj:2: malformed number '1\\x01'"},
       {"zero_line_index", "v 0 0 0\nv 1 0 0\nl 0 1\n", "bad.obj:3: "},
@@ -138,8 +145,9 @@ TEST(Loader, UnusualButValidInputIsAccepted) {
   EXPECT_EQ(s.triangles[0].v2, (Vec3{0, 1, 0}));
   EXPECT_EQ(s.vertex_count, 3u);
   // A BOM in the MTL too: the material's name is read without it.
-  const Scene m = load_obj_from_string("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n", "\xEF\xBB\xBFnewmtl red\nKd 1 0 0\n",
-                                       "bom.obj", [](const std::string& w) { ADD_FAILURE() << w; });
+  const Scene m = load_obj_from_string("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n",
+                                       "\xEF\xBB\xBFnewmtl red\nKd 1 0 0\n", "bom.obj",
+                                       [](const std::string& w) { ADD_FAILURE() << w; });
   EXPECT_EQ(m.materials[m.tri_material[0]].name, "red");
 }
 
@@ -170,7 +178,8 @@ TEST(Loader, ReadsPipesAndNamesTheRealCauseOfOpenErrors) {
     load_obj(dir + "/loop-a");
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot open: too many levels of symbolic links"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot open: too many levels of symbolic links"), std::string::npos)
+        << e.what();
   }
   try {
     load_obj(dir);

@@ -7,8 +7,8 @@
 #include "accel/accelerator.hpp"
 #include "io/image_io.hpp"
 #include "render/shading.hpp"
-#include "sched/scheduler.hpp"
 #include "scene/builtin.hpp"
+#include "sched/scheduler.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -27,7 +27,8 @@ Framebuffer render(const Scene& scene, const CameraSpec& cam, const RenderSettin
 TEST(Render, LitQuadMatchesLambert) {
   // A 10x10 quad in z = 0 facing +z (filling the view), Kd 0.5, one point light of intensity 3 at (0.5, -0.25, 2),
   // AO off and no ambient: each pixel's radiance is Kd/pi * I * cos(theta) / d^2.
-  Scene scene = test::scene_of({Triangle{{-5, -5, 0}, {5, -5, 0}, {5, 5, 0}}, Triangle{{-5, -5, 0}, {5, 5, 0}, {-5, 5, 0}}});
+  Scene scene =
+      test::scene_of({Triangle{{-5, -5, 0}, {5, -5, 0}, {5, 5, 0}}, Triangle{{-5, -5, 0}, {5, 5, 0}, {-5, 5, 0}}});
   scene.materials[0].kd = Vec3{0.5f};
   const Vec3 light{0.5f, -0.25f, 2.0f};
   scene.lights.push_back(Light{.position = light, .normal = {}, .power = Vec3{3.0f}});
@@ -58,8 +59,9 @@ TEST(Render, LitQuadMatchesLambert) {
 
 TEST(Render, ShadowedPointIsAmbientOnly) {
   // A blocker between the light and the quad's centre leaves exactly the ambient term there.
-  Scene scene = test::scene_of({Triangle{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}}, Triangle{{-2, -2, 0}, {2, 2, 0}, {-2, 2, 0}},
-                                Triangle{{-0.2f, -0.2f, 1}, {0.2f, -0.2f, 1}, {0, 0.3f, 1}}});
+  Scene scene =
+      test::scene_of({Triangle{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}}, Triangle{{-2, -2, 0}, {2, 2, 0}, {-2, 2, 0}},
+                      Triangle{{-0.2f, -0.2f, 1}, {0.2f, -0.2f, 1}, {0, 0.3f, 1}}});
   scene.lights.push_back(Light{.position = {0, 0, 2}, .normal = {}, .power = Vec3{3.0f}});
   const CameraSpec cam{{0.0f, -1.0f, 3.0f}, {0, 0, 0}, {0, 1, 0}, 60.0f};
   RenderSettings s;

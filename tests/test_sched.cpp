@@ -7,9 +7,9 @@
 
 #include "accel/accelerator.hpp"
 #include "render/shading.hpp"
-#include "sched/scheduler.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
+#include "sched/scheduler.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -21,7 +21,8 @@ struct Rendered {
   RayCounts counts;
 };
 
-Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size, bool packets = false) {
+Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size,
+                     bool packets = false) {
   RenderSettings s;
   s.packets = packets;
   s.width = size;
@@ -56,7 +57,8 @@ std::vector<Scene> scenes() {
   v.push_back(make_cornell_box(500));
   if (test::have_shared_scenes()) {
     for (const char* name : {"Original", "Mirror", "Sphere", "Water"}) {
-      v.push_back(load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"), [](const std::string&) {}));
+      v.push_back(load_obj(test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"),
+                           [](const std::string&) {}));
     }
   }
   return v;

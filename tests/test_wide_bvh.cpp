@@ -32,8 +32,10 @@ size_t disagreements(const Scene& scene, const std::vector<Ray>& rays) {
   for (const Ray& r : rays) {
     Hit a, b;
     const bool ha = bin.intersect(r, a), hb = wide.intersect(r, b);
-    const bool same = ha == hb && (!ha || (a.tri == b.tri && a.t == b.t && a.u == b.u && a.v == b.v && a.primID == b.primID && a.geomID == b.geomID));
-    if (!same && bad++ < 3) ADD_FAILURE() << "closest hit differs: tri " << a.tri << " t " << a.t << " vs tri " << b.tri << " t " << b.t;
+    const bool same = ha == hb && (!ha || (a.tri == b.tri && a.t == b.t && a.u == b.u && a.v == b.v &&
+                                           a.primID == b.primID && a.geomID == b.geomID));
+    if (!same && bad++ < 3)
+      ADD_FAILURE() << "closest hit differs: tri " << a.tri << " t " << a.t << " vs tri " << b.tri << " t " << b.t;
     Ray shadow = r;
     shadow.tfar = ha ? a.t * 0.5f : length(scene.bounds.extent()) * 0.3f;
     if (bin.occluded(r) != wide.occluded(r) || bin.occluded(shadow) != wide.occluded(shadow)) {
@@ -48,7 +50,8 @@ std::vector<Scene> agreement_scenes() {
   std::vector<Scene> scenes;
   scenes.push_back(make_cornell_box(5000));
   if (test::have_shared_scenes()) {
-    for (const char* p : {"cornell-box/CornellBox-Original.obj", "cornell-box/CornellBox-Water.obj", "sponza/sponza.obj", "bunny/bunny.obj"}) {
+    for (const char* p : {"cornell-box/CornellBox-Original.obj", "cornell-box/CornellBox-Water.obj",
+                          "sponza/sponza.obj", "bunny/bunny.obj"}) {
       scenes.push_back(load_obj(test::scene_path(p), [](const std::string&) {}));
     }
   }
@@ -150,9 +153,10 @@ TEST(SimdBruteForce, AgreesWithScalarBruteForceOnEveryTarget) {
   std::vector<Scene> scenes;
   scenes.push_back(make_cornell_box(300));
   const Triangle t{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  scenes.push_back(test::scene_of({t}));                                   // one pack, seven padding lanes
-  scenes.push_back(test::scene_of(std::vector<Triangle>(17, t)));          // ties across packs
-  if (test::have_shared_scenes()) scenes.push_back(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
+  scenes.push_back(test::scene_of({t}));                           // one pack, seven padding lanes
+  scenes.push_back(test::scene_of(std::vector<Triangle>(17, t)));  // ties across packs
+  if (test::have_shared_scenes())
+    scenes.push_back(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
   for (const std::string& target : targets()) {
     ASSERT_TRUE(WideBvh::force_simd_target(target));
     for (const Scene& scene : scenes) {
@@ -201,9 +205,11 @@ size_t packet_disagreements(const WideBvh& wide, const std::vector<Ray>& rays, u
       Hit single;
       const bool hs = wide.intersect(rays[first + size_t(k)], single);
       const Hit& h = hits[k];
-      const bool same = hs == h.valid() && h.tri == single.tri && h.t == single.t && h.u == single.u && h.v == single.v &&
-                        h.geomID == single.geomID && h.primID == single.primID;
-      if (!same && bad++ < 3) ADD_FAILURE() << "packet lane " << k << ": tri " << h.tri << " t " << h.t << " vs " << single.tri << " t " << single.t;
+      const bool same = hs == h.valid() && h.tri == single.tri && h.t == single.t && h.u == single.u &&
+                        h.v == single.v && h.geomID == single.geomID && h.primID == single.primID;
+      if (!same && bad++ < 3)
+        ADD_FAILURE() << "packet lane " << k << ": tri " << h.tri << " t " << h.t << " vs " << single.tri << " t "
+                      << single.t;
     }
   }
   return bad;
@@ -257,7 +263,8 @@ TEST(RayPackets, RaysThroughVerticesAndEdges) {
       rays.push_back(r);
     }
   }
-  std::stable_partition(rays.begin(), rays.end(), [](const Ray& r) { return r.dir.y != 0.0f; });  // shared axes per packet
+  std::stable_partition(rays.begin(), rays.end(),
+                        [](const Ray& r) { return r.dir.y != 0.0f; });  // shared axes per packet
   for (const std::string& target : targets()) {
     ASSERT_TRUE(WideBvh::force_simd_target(target));
     const WideBvh wide(scene, BvhBuildOptions{});
@@ -298,7 +305,7 @@ std::vector<BundleCase> bundles_for(const Scene& scene, size_t count, uint32_t s
     c.rays.org = b % 5 == 0 ? p : offset_origin(p, n);
     c.rays.tfar = b % 3 == 0 ? finite : kInfinity;
     uint32_t lanes = 0xffffu;
-    if (b % 7 == 0) lanes = 0x8421u | (rng() & 0xffffu);  // sparse
+    if (b % 7 == 0) lanes = 0x8421u | (rng() & 0xffffu);     // sparse
     if (b % 11 == 0) lanes = (1u << (1 + rng() % 15)) - 1u;  // the first few lanes only
     for (int k = 0; k < kPacketSize; ++k) {
       if (!((lanes >> k) & 1u)) continue;
@@ -320,7 +327,8 @@ size_t bundle_disagreements(const A& accel, const std::vector<BundleCase>& cases
     for (uint32_t bits = c.rays.active; bits; bits &= bits - 1) {
       const int k = __builtin_ctz(bits);
       const bool alone = accel.occluded(c.rays.ray(k));
-      if (alone != (((got >> k) & 1u) != 0) && bad++ < 3) ADD_FAILURE() << "bundle lane " << k << " from triangle " << c.origin << ": alone " << alone;
+      if (alone != (((got >> k) & 1u) != 0) && bad++ < 3)
+        ADD_FAILURE() << "bundle lane " << k << " from triangle " << c.origin << ": alone " << alone;
     }
   }
   return bad;

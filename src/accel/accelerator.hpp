@@ -34,7 +34,8 @@ struct AccelOptions {
 
 using AccelVariant = std::variant<BruteForce, SimdBruteForce, Bvh, WideBvh
 #ifdef TRACER_HAVE_EMBREE
-                                  , EmbreeAccel
+                                  ,
+                                  EmbreeAccel
 #endif
                                   >;
 
@@ -45,7 +46,9 @@ struct Accelerator {
   std::string name;
 
   template <class F>
-  decltype(auto) visit(F&& f) const { return std::visit(std::forward<F>(f), *impl); }
+  decltype(auto) visit(F&& f) const {
+    return std::visit(std::forward<F>(f), *impl);
+  }
   size_t memory_bytes() const;
   // The binary BVH's shape (nodes, leaves, depth, SAH cost); empty for the other accelerators.
   std::optional<BvhStats> bvh_stats() const;

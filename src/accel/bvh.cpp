@@ -7,15 +7,15 @@ namespace tracer {
 
 namespace {
 struct ChildHits {
-  bool a, b;       // whether the first and second child's boxes are entered within [tnear, tfar]
-  float ta, tb;    // their entry distances
+  bool a, b;     // whether the first and second child's boxes are entered within [tnear, tfar]
+  float ta, tb;  // their entry distances
 };
 
 // The step both traversals take at an interior node: its two children's boxes tested from the
 // parent, and what each child's visit will read requested now, so the loads of the near and the
 // far path overlap (trees larger than L2 wait on dependent node loads).
-inline ChildHits test_children(const BvhNode& parent, const BvhNode* nodes, const Triangle* tris, const RayBoxTest& box, float tnear,
-                               float tfar) {
+inline ChildHits test_children(const BvhNode& parent, const BvhNode* nodes, const Triangle* tris, const RayBoxTest& box,
+                               float tnear, float tfar) {
   const BvhNode& a = nodes[parent.index];
   const BvhNode& b = nodes[parent.index + 1];
   prefetch_child(a, nodes, tris);
@@ -35,7 +35,10 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
   const RayBoxTest box(ray);
   if (box.enter(nodes_[0], ray.tnear, hit.t) == kInfinity) return false;
 
-  struct Entry { uint32_t node; float t; };
+  struct Entry {
+    uint32_t node;
+    float t;
+  };
   Entry stack[kMaxDepth + 2];
   int sp = 0;
   uint32_t current = 0;
@@ -149,7 +152,10 @@ BvhStats Bvh::stats() const {
   s.nodes = nodes_.size();
   if (nodes_.empty()) return s;
   const double root_area = std::max(1e-30f, Aabb{nodes_[0].lo, nodes_[0].hi}.half_area());
-  struct Item { uint32_t node; size_t depth; };
+  struct Item {
+    uint32_t node;
+    size_t depth;
+  };
   std::vector<Item> stack{{0, 1}};
   size_t leaf_tris = 0;
   while (!stack.empty()) {
@@ -177,7 +183,10 @@ std::string Bvh::validate() const {
   std::ostringstream err;
   if (nodes_.empty()) return tris_.empty() ? "" : "triangles but no nodes";
   std::vector<uint32_t> seen(scene_->size(), 0);
-  struct Item { uint32_t node; size_t depth; };
+  struct Item {
+    uint32_t node;
+    size_t depth;
+  };
   std::vector<Item> stack{{0, 1}};
   std::vector<uint32_t> visits(nodes_.size(), 0);
   const size_t leaf_limit = options_.split == BvhSplit::Median ? 2 : size_t(options_.max_leaf);
@@ -190,13 +199,16 @@ std::string Bvh::validate() const {
     const BvhNode& n = nodes_[it.node];
     const Aabb box{n.lo, n.hi};
     if (n.leaf()) {
-      if (n.count > leaf_limit) return "leaf " + std::to_string(it.node) + " holds " + std::to_string(n.count) + " triangles";
+      if (n.count > leaf_limit)
+        return "leaf " + std::to_string(it.node) + " holds " + std::to_string(n.count) + " triangles";
       if (size_t(n.index) + n.count > tris_.size()) return "leaf range out of bounds";
       for (uint32_t i = n.index; i < n.index + n.count; ++i) {
-        if (!box.contains(tris_[i].bounds())) return "leaf " + std::to_string(it.node) + " box does not contain triangle " + std::to_string(ids_[i]);
+        if (!box.contains(tris_[i].bounds()))
+          return "leaf " + std::to_string(it.node) + " box does not contain triangle " + std::to_string(ids_[i]);
         if (ids_[i] >= seen.size()) return "triangle id out of range";
         ++seen[ids_[i]];
-        if (leaf_of_.size() != seen.size() || leaf_of_[ids_[i]] != it.node) return "leaf_of does not name the leaf of triangle " + std::to_string(ids_[i]);
+        if (leaf_of_.size() != seen.size() || leaf_of_[ids_[i]] != it.node)
+          return "leaf_of does not name the leaf of triangle " + std::to_string(ids_[i]);
         if (!(scene_->triangles[ids_[i]].v0 == tris_[i].v0)) return "reordered triangle differs from scene";
       }
     } else {
@@ -205,14 +217,16 @@ std::string Bvh::validate() const {
         return "node " + std::to_string(it.node) + " is not its children's recorded parent";
       }
       for (uint32_t c = n.index; c <= n.index + 1; ++c) {
-        if (!box.contains(Aabb{nodes_[c].lo, nodes_[c].hi})) return "node " + std::to_string(it.node) + " does not contain child " + std::to_string(c);
+        if (!box.contains(Aabb{nodes_[c].lo, nodes_[c].hi}))
+          return "node " + std::to_string(it.node) + " does not contain child " + std::to_string(c);
         stack.push_back({c, it.depth + 1});
       }
     }
   }
   for (size_t i = 0; i < seen.size(); ++i) {
     const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
-    if (expected == 0 && leaf_of_.size() == seen.size() && leaf_of_[i] != kNoLeaf) return "degenerate triangle " + std::to_string(i) + " has a leaf";
+    if (expected == 0 && leaf_of_.size() == seen.size() && leaf_of_[i] != kNoLeaf)
+      return "degenerate triangle " + std::to_string(i) + " has a leaf";
     if (seen[i] != expected) {
       err << "triangle " << i << " appears in " << seen[i] << " leaves, expected " << expected;
       return err.str();

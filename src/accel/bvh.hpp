@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <cstring>
 #include <new>
+#include <string>
 #include <type_traits>
 #include <utility>
-#include <string>
 #include <vector>
 
 #include "accel/triangle_test.hpp"
@@ -25,9 +25,9 @@ enum class BuildMode { Seq, Async, Queue, Tasks };
 struct BvhBuildOptions {
   BvhSplit split = BvhSplit::Sah;
   BuildMode mode = BuildMode::Seq;
-  int threads = 0;       // 0: all hardware threads (parallel modes only)
-  int max_leaf = 4;      // SAH: largest leaf; the median split always makes leaves of 1-2
-  int bins = 16;         // SAH bins per axis
+  int threads = 0;   // 0: all hardware threads (parallel modes only)
+  int max_leaf = 4;  // SAH: largest leaf; the median split always makes leaves of 1-2
+  int bins = 16;     // SAH bins per axis
   // Relative costs for the SAH. 1.5 rather than 1 for a node step: traversal measured the same
   // on every scene (docs/BENCHMARKS.md section 4), with 10-25 % fewer nodes to build and store.
   float traversal_cost = 1.5f;
@@ -65,8 +65,8 @@ struct CacheAlignedAllocator {
   CacheAlignedAllocator() = default;
   template <class U>
   CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
-  void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t{64}); }
+  T* allocate(size_t n) { return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{64})); }
+  void deallocate(T* p, size_t) { ::operator delete (p, std::align_val_t{64}); }
   // resize() leaves new elements uninitialised (they are plain implicit-lifetime aggregates the
   // builder overwrites, in parallel): zeroing megabytes first cost as much as the flattening.
   template <class U>
@@ -78,7 +78,9 @@ struct CacheAlignedAllocator {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   template <class U>
-  bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+  bool operator==(const CacheAlignedAllocator<U>&) const {
+    return true;
+  }
 };
 
 using BvhNodeArray = std::vector<BvhNode, CacheAlignedAllocator<BvhNode>>;
@@ -118,8 +120,12 @@ class Bvh {
   const BvhBuildOptions& options() const { return options_; }
   const Scene& scene() const { return *scene_; }
   static constexpr uint32_t kNoLeaf = 0xffffffffu;
-  const std::vector<uint32_t>& pair_parents() const { return pair_parent_; }  // parent of pair nodes[2k], nodes[2k+1], at k
-  const std::vector<uint32_t>& leaf_of() const { return leaf_of_; }  // leaf of each scene triangle (kNoLeaf: degenerate)
+  const std::vector<uint32_t>& pair_parents() const {
+    return pair_parent_;
+  }  // parent of pair nodes[2k], nodes[2k+1], at k
+  const std::vector<uint32_t>& leaf_of() const {
+    return leaf_of_;
+  }  // leaf of each scene triangle (kNoLeaf: degenerate)
   BvhStats stats() const;
   size_t memory_bytes() const {
     return nodes_.size() * sizeof(BvhNode) + tris_.size() * sizeof(Triangle) +

@@ -15,11 +15,11 @@
 #include <atomic>
 #include <bit>
 #include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <future>
-#include <mutex>
-#include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <utility>
 
@@ -32,10 +32,10 @@ namespace tracer {
 namespace {
 
 constexpr uint32_t kNone = 0xffffffffu;
-constexpr uint32_t kParallelSubtree = 4096;   // below this a subtree is built by one thread
-constexpr uint32_t kParallelSplit = 65536;    // above this one node's passes run in parallel (tasks)
-constexpr uint32_t kPartitionBlock = 16384;   // block size of the parallel stable partition
-constexpr uint32_t kMedianFallbackDepth = 64; // SAH switches to object median below this depth
+constexpr uint32_t kParallelSubtree = 4096;    // below this a subtree is built by one thread
+constexpr uint32_t kParallelSplit = 65536;     // above this one node's passes run in parallel (tasks)
+constexpr uint32_t kPartitionBlock = 16384;    // block size of the parallel stable partition
+constexpr uint32_t kMedianFallbackDepth = 64;  // SAH switches to object median below this depth
 constexpr int kMaxBins = 32;
 
 struct BuildNode {
@@ -57,7 +57,9 @@ struct alignas(32) PrimRef {
   static PrimRef make(const Aabb& b, uint32_t id) {
     return {_mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, std::bit_cast<float>(id)), _mm_setr_ps(b.hi.x, b.hi.y, b.hi.z, 0.0f)};
   }
-  uint32_t id() const { return std::bit_cast<uint32_t>(_mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3)))); }
+  uint32_t id() const {
+    return std::bit_cast<uint32_t>(_mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3))));
+  }
   // (lo + hi) / 2 per axis, as Aabb::center() computes it; lane 3 is masked off first so the
   // id's bits never enter arithmetic (they may look like a denormal).
   __m128 center() const {
@@ -129,7 +131,8 @@ class BvhBuilder {
     tbb::parallel_for(0u, blocks, [&](uint32_t k) {
       publish();
       uint32_t c = 0;
-      for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i) c += scene.triangles[i].degenerate() ? 0 : 1;
+      for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i)
+        c += scene.triangles[i].degenerate() ? 0 : 1;
       offsets[k + 1] = c;
       publish();
     });
@@ -150,9 +153,15 @@ class BvhBuilder {
     node_count_ = 1;
     const int threads = resolve_thread_count(options_.threads);
     switch (options_.mode) {
-      case BuildMode::Seq: build_subtree(0); break;
-      case BuildMode::Async: build_async(0, async_depth_limit(threads)); break;
-      case BuildMode::Queue: build_queue(threads); break;
+      case BuildMode::Seq:
+        build_subtree(0);
+        break;
+      case BuildMode::Async:
+        build_async(0, async_depth_limit(threads));
+        break;
+      case BuildMode::Queue:
+        build_queue(threads);
+        break;
       case BuildMode::Tasks: {
         build_tasks(0);  // inside the caller's task arena
         publish();
@@ -165,7 +174,8 @@ class BvhBuilder {
   // triangle index of every leaf slot. Each subtree's place follows from its size alone, so the
   // tasks build flattens its large subtrees in parallel into the same layout.
   // `pair_parent` receives each sibling pair's parent, `leaf_of` each scene triangle's leaf.
-  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent, std::vector<uint32_t>& leaf_of) {
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent,
+               std::vector<uint32_t>& leaf_of) {
     ids.resize(count_);
     // subtree_size() also fills in the sizes the queue build left unknown at the top.
     out.resize(count_ == 0 ? 0 : subtree_size(0) + 1);  // + the padding node
@@ -189,7 +199,8 @@ class BvhBuilder {
   // subtrees never write neighbouring nodes (no false sharing) and take no atomic per node.
   void build_subtree(uint32_t id) {
     const BuildNode& n = nodes_[id];
-    uint32_t cursor = n.end - n.begin > 1 ? node_count_.fetch_add(2 * (n.end - n.begin) - 2, std::memory_order_relaxed) : 0;
+    uint32_t cursor =
+        n.end - n.begin > 1 ? node_count_.fetch_add(2 * (n.end - n.begin) - 2, std::memory_order_relaxed) : 0;
     build_seq(id, cursor);
   }
 
@@ -268,7 +279,17 @@ class BvhBuilder {
     if (!split(id, size >= kParallelSplit)) return finish(id);
     const uint32_t left = nodes_[id].left;
     publish();  // the children's nodes and primitives, written above, to whichever thread takes them
-    tbb::parallel_invoke([&] { publish(); build_tasks(left); publish(); }, [&] { publish(); build_tasks(left + 1); publish(); });
+    tbb::parallel_invoke(
+        [&] {
+          publish();
+          build_tasks(left);
+          publish();
+        },
+        [&] {
+          publish();
+          build_tasks(left + 1);
+          publish();
+        });
     publish();
     finish(id);
   }
@@ -323,7 +344,17 @@ class BvhBuilder {
     const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
     const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
     if (parallel && n.end - n.begin >= kParallelSubtree) {
-      tbb::parallel_invoke([&] { publish(); place_left(); publish(); }, [&] { publish(); place_right(); publish(); });
+      tbb::parallel_invoke(
+          [&] {
+            publish();
+            place_left();
+            publish();
+          },
+          [&] {
+            publish();
+            place_right();
+            publish();
+          });
     } else {
       place_left();
       place_right();
@@ -392,9 +423,8 @@ class BvhBuilder {
           const Binner binner(node.cbox, sah.bins);
           child_buffer = uint8_t(1 - node.buffer);
           SideCentroids centroids;
-          mid = partition(refs, buffers_[child_buffer].get(), begin, end, begin + sah.left_count, parallel, centroids, [&](const PrimRef& prim) {
-            return binner(prim.center(sah.axis), sah.axis) < sah.split_bin;
-          });
+          mid = partition(refs, buffers_[child_buffer].get(), begin, end, begin + sah.left_count, parallel, centroids,
+                          [&](const PrimRef& prim) { return binner(prim.center(sah.axis), sah.axis) < sah.split_bin; });
           child_box[0] = sah.left_box;
           child_box[1] = sah.right_box;
           child_cbox[0] = Bounds4::to_aabb(centroids.llo, centroids.lhi);
@@ -403,7 +433,8 @@ class BvhBuilder {
         }
       }
     }
-    const uint32_t left = cursor ? std::exchange(*cursor, *cursor + 2) : node_count_.fetch_add(2, std::memory_order_relaxed);
+    const uint32_t left =
+        cursor ? std::exchange(*cursor, *cursor + 2) : node_count_.fetch_add(2, std::memory_order_relaxed);
     nodes_[left] = BuildNode{{}, begin, mid, kNone, node.depth + 1};
     nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
     if (children_known) {
@@ -420,9 +451,12 @@ class BvhBuilder {
 
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis) {
     switch (axis) {
-      case 0: return median_split<0>(refs, begin, end);
-      case 1: return median_split<1>(refs, begin, end);
-      default: return median_split<2>(refs, begin, end);
+      case 0:
+        return median_split<0>(refs, begin, end);
+      case 1:
+        return median_split<1>(refs, begin, end);
+      default:
+        return median_split<2>(refs, begin, end);
     }
   }
   template <int Axis>
@@ -479,10 +513,12 @@ class BvhBuilder {
     int nb;
     RawBin bins[3][kMaxBins];
     explicit BinSet(int n) : nb(n) {
-      for (auto& axis : bins) for (int b = 0; b < nb; ++b) axis[b].reset();
+      for (auto& axis : bins)
+        for (int b = 0; b < nb; ++b) axis[b].reset();
     }
     void join(const BinSet& o) {
-      for (int a = 0; a < 3; ++a) for (int b = 0; b < nb; ++b) bins[a][b].add(o.bins[a][b]);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < nb; ++b) bins[a][b].add(o.bins[a][b]);
     }
   };
 
@@ -620,8 +656,8 @@ class BvhBuilder {
   // Each primitive is stored once at a selected index: the side decides no branch, which the
   // CPU could not predict. The parallel path computes the same permutation and bounds.
   template <class Pred>
-  uint32_t partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, SideCentroids& out,
-                     const Pred& pred) {
+  uint32_t partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel,
+                     SideCentroids& out, const Pred& pred) {
     const auto run = [&](uint32_t b, uint32_t e, uint32_t l, uint32_t r, SideCentroids& acc) {
       for (uint32_t i = b; i < e; ++i) {
         const PrimRef& p = src[i];

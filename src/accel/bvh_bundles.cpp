@@ -60,7 +60,8 @@ HWY_INLINE uint32_t OccludedInLeaf(const BvhNode& n, const Triangle* tris, const
 }
 
 // The lanes of `mask`, all entering node `root`'s box, whose rays hit a triangle below it.
-HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, const RayBundle& rays, uint32_t root, const BundleState& st, uint32_t mask) {
+HWY_INLINE uint32_t OccludedBelow(const Bvh& bvh, const RayBundle& rays, uint32_t root, const BundleState& st,
+                                  uint32_t mask) {
   const BvhNode* nodes = bvh.nodes().data();
   const Triangle* tris = bvh.triangles().data();
   struct Entry {

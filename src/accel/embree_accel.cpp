@@ -17,7 +17,8 @@ bool EmbreeAccel::monitor(void* user, ssize_t bytes, bool /*post*/) {
 
 EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel) : scene_(&scene) {
   device_ = rtcNewDevice(nullptr);
-  if (!device_) throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  if (!device_)
+    throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
   rtc_scene_ = rtcNewScene(device_);
   // One Embree geometry per scene geometry, attached in order, so geomID and primID coincide.
@@ -43,7 +44,8 @@ EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel) : scene_(&scene)
   }
   // Embree asks this during the build; false cancels it (a Ctrl-C during a long build).
   rtcSetSceneProgressMonitorFunction(
-      rtc_scene_, [](void* flag, double) { return !is_cancelled(static_cast<CancelFlag>(flag)); }, const_cast<std::atomic<bool>*>(cancel));
+      rtc_scene_, [](void* flag, double) { return !is_cancelled(static_cast<CancelFlag>(flag)); },
+      const_cast<std::atomic<bool>*>(cancel));
   rtcCommitScene(rtc_scene_);
   const bool cancelled = is_cancelled(cancel), failed = rtcGetDeviceError(device_) != RTC_ERROR_NONE;
   if (cancelled || failed) {

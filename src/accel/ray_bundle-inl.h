@@ -35,7 +35,8 @@ struct BundleState {
   float org[3];
   float tnear, tfar;
 
-  explicit BundleState(const RayBundle& rays) : org{rays.org.x, rays.org.y, rays.org.z}, tnear(rays.tnear), tfar(rays.tfar) {
+  explicit BundleState(const RayBundle& rays)
+      : org{rays.org.x, rays.org.y, rays.org.z}, tnear(rays.tnear), tfar(rays.tfar) {
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;
     const size_t N = hn::Lanes(d);
@@ -56,12 +57,14 @@ struct BundleState {
       hn::Store(hn::ShiftRight<31>(hn::BitCast(di, rz)), di, nz + i);
       // RayShear: kz = max_dimension(abs(dir)), kx and ky the next axes, swapped when dir[kz] < 0.
       const auto axd = hn::Abs(dx), ayd = hn::Abs(dy), azd = hn::Abs(dz);
-      const auto k_z = hn::IfThenElse(hn::RebindMask(di, hn::Gt(axd, ayd)), hn::IfThenElse(hn::RebindMask(di, hn::Gt(axd, azd)), i0, i2),
+      const auto k_z = hn::IfThenElse(hn::RebindMask(di, hn::Gt(axd, ayd)),
+                                      hn::IfThenElse(hn::RebindMask(di, hn::Gt(axd, azd)), i0, i2),
                                       hn::IfThenElse(hn::RebindMask(di, hn::Gt(ayd, azd)), i1, i2));
       auto k_x = hn::IfThenElse(hn::Eq(k_z, i2), i0, hn::Add(k_z, i1));
       auto k_y = hn::IfThenElse(hn::Eq(k_x, i2), i0, hn::Add(k_x, i1));
       const auto pick = [&](hn::Vec<decltype(di)> k) {
-        return hn::IfThenElse(hn::RebindMask(d, hn::Eq(k, i0)), dx, hn::IfThenElse(hn::RebindMask(d, hn::Eq(k, i1)), dy, dz));
+        return hn::IfThenElse(hn::RebindMask(d, hn::Eq(k, i0)), dx,
+                              hn::IfThenElse(hn::RebindMask(d, hn::Eq(k, i1)), dy, dz));
       };
       const auto dkz = pick(k_z);
       const auto flip = hn::RebindMask(di, hn::Lt(dkz, zero));
@@ -98,8 +101,10 @@ HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const Bu
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
-  const auto lo_x = hn::Set(d, lo[0] - st.org[0]), lo_y = hn::Set(d, lo[1] - st.org[1]), lo_z = hn::Set(d, lo[2] - st.org[2]);
-  const auto hi_x = hn::Set(d, hi[0] - st.org[0]), hi_y = hn::Set(d, hi[1] - st.org[1]), hi_z = hn::Set(d, hi[2] - st.org[2]);
+  const auto lo_x = hn::Set(d, lo[0] - st.org[0]), lo_y = hn::Set(d, lo[1] - st.org[1]),
+             lo_z = hn::Set(d, lo[2] - st.org[2]);
+  const auto hi_x = hn::Set(d, hi[0] - st.org[0]), hi_y = hn::Set(d, hi[1] - st.org[1]),
+             hi_z = hn::Set(d, hi[2] - st.org[2]);
   const auto tnear = hn::Set(d, st.tnear), tfar = hn::Set(d, st.tfar * RayBoxTest::kTieGuard);
   uint32_t hits = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
@@ -133,8 +138,8 @@ HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const Bu
 // its shear axes from those with selects; every lane then runs the scalar test's operations in
 // its order, so its answer is the scalar test's. Lanes with an edge function exactly zero are
 // redone by the scalar test, which decides them in double.
-HWY_INLINE uint32_t OccludedByTriangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Triangle& tri, const BundleState& st,
-                                       uint32_t mask) {
+HWY_INLINE uint32_t OccludedByTriangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Triangle& tri,
+                                       const BundleState& st, uint32_t mask) {
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
@@ -171,8 +176,11 @@ HWY_INLINE uint32_t OccludedByTriangle(const Vec3& v0, const Vec3& v1, const Vec
     if (!hn::AllFalse(d, inside)) {
       const auto det = hn::Add(hn::Add(u, v), w);
       const auto rcp = hn::Div(one, det);
-      const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, akz)), hn::Mul(v, hn::Mul(sz, bkz))), hn::Mul(w, hn::Mul(sz, ckz))), rcp);
-      const auto hit = hn::And(hn::AndNot(hn::Eq(det, zero), inside), hn::And(hn::And(hn::Ge(t, tnear), hn::Le(t, tfar)), hn::Lt(t, inf)));
+      const auto t = hn::Mul(
+          hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, akz)), hn::Mul(v, hn::Mul(sz, bkz))), hn::Mul(w, hn::Mul(sz, ckz))),
+          rcp);
+      const auto hit = hn::And(hn::AndNot(hn::Eq(det, zero), inside),
+                               hn::And(hn::And(hn::Ge(t, tnear), hn::Le(t, tfar)), hn::Lt(t, inf)));
       hits |= Bits(d, hit) << i;
     }
     for (; edge; edge &= edge - 1) {  // exactly on an edge in float: the scalar test decides

@@ -73,9 +73,7 @@ inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tne
 
 // Closest-hit ordering shared by every accelerator: nearer t wins, equal t goes to the lower
 // scene triangle index, so the answer never depends on traversal order.
-inline bool closer(float t, uint32_t tri, const Hit& best) {
-  return t < best.t || (t == best.t && tri < best.tri);
-}
+inline bool closer(float t, uint32_t tri, const Hit& best) { return t < best.t || (t == best.t && tri < best.tri); }
 
 // Ends a closest-hit query: names the hit triangle by geomID/primID; false if nothing was hit.
 inline bool finish_hit(const Scene& scene, Hit& hit) {
@@ -87,8 +85,8 @@ inline bool finish_hit(const Scene& scene, Hit& hit) {
 
 // Closest hit among tris[begin, end) whose scene indices are ids[...]: updates `hit` (t, u, v,
 // tri) where a triangle is closer. The leaf loop of every scalar accelerator.
-inline void intersect_range(const RayShear& shear, const Triangle* tris, const uint32_t* ids, uint32_t begin, uint32_t end,
-                            float tnear, Hit& hit) {
+inline void intersect_range(const RayShear& shear, const Triangle* tris, const uint32_t* ids, uint32_t begin,
+                            uint32_t end, float tnear, Hit& hit) {
   for (uint32_t i = begin; i < end; ++i) {
     TriangleHit th;
     if (intersect_triangle(shear, tris[i], tnear, hit.t, th) && closer(th.t, ids[i], hit)) {

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <limits>
 
-#include "accel/wide_bvh.hpp"
 #include "accel/ray_bundle-inl.h"
+#include "accel/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -38,7 +38,8 @@ struct WideRay {
 };
 
 // Tests all children of `n`; writes their entry distances to t_out and returns one bit per child hit.
-HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar, float* HWY_RESTRICT t_out) {
+HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar,
+                                 float* HWY_RESTRICT t_out) {
   const hn::CappedTag<float, kWideWidth> d;
   const size_t lanes = hn::Lanes(d);
   const float* near_x = r.nx ? n.hi_x : n.lo_x;
@@ -79,8 +80,9 @@ HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnea
 // the scalar test's bit for bit. Lanes whose edge function is exactly zero are redone by the
 // scalar test (which decides them in double), as are none in the common case.
 // Returns the mask of lanes hit within [tnear, tfar]; their t, u, v go to the arrays.
-HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, const Triangle* tris, float tnear, float tfar,
-                                  float* HWY_RESTRICT t_out, float* HWY_RESTRICT u_out, float* HWY_RESTRICT v_out) {
+HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, const Triangle* tris, float tnear,
+                                  float tfar, float* HWY_RESTRICT t_out, float* HWY_RESTRICT u_out,
+                                  float* HWY_RESTRICT v_out) {
   const hn::CappedTag<float, kWideWidth> d;
   const size_t lanes = hn::Lanes(d);
   const float org[3] = {s.org.x, s.org.y, s.org.z};
@@ -109,7 +111,9 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
     if (hn::AllTrue(d, hn::AndNot(on_edge, hn::And(neg, pos)))) continue;
     const auto det = hn::Add(hn::Add(u, v), w);
     const auto rcp = hn::Div(one, det);
-    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))), rcp);
+    const auto t = hn::Mul(
+        hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))),
+        rcp);
     auto hit = hn::AndNot(hn::And(neg, pos), det != zero);
     hit = hn::And(hit, hn::And(hn::And(t >= vnear, t <= vfar), t < inf));
     hn::Store(t, d, t_out + i);
@@ -140,8 +144,8 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
 // Updates `hit` with the closest lane of `pack` (ties to the lower scene index, as everywhere).
 // The nearest of several hit lanes is found by a SIMD minimum over the lanes, not a loop; only
 // lanes tied exactly at that minimum (rare) are compared one by one for the lower index.
-HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, const uint32_t* ids, float tnear,
-                              Hit& hit) {
+HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, const uint32_t* ids,
+                              float tnear, Hit& hit) {
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
   const uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv);
   if (bits == 0) return;
@@ -155,7 +159,8 @@ HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, cons
       return hn::LoadMaskBits(d, b);
     };
     auto tmin = inf;
-    for (size_t i = 0; i < size_t(kWideWidth); i += lanes) tmin = hn::Min(tmin, hn::IfThenElse(lane_mask(i), hn::Load(d, tt + i), inf));
+    for (size_t i = 0; i < size_t(kWideWidth); i += lanes)
+      tmin = hn::Min(tmin, hn::IfThenElse(lane_mask(i), hn::Load(d, tt + i), inf));
     tmin = hn::MinOfLanes(d, tmin);
     nearest = 0;
     for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
@@ -184,7 +189,8 @@ struct StackEntry {
 // Chooses the next child to visit among the hit children `bits` of `n` and pushes the others,
 // farthest first. One or two hits (by far the common cases) take no sort; more are sorted by an
 // insertion sort of at most eight entries. Returns false when no child was hit.
-HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackEntry* stack, int& sp, StackEntry& next) {
+HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackEntry* stack, int& sp,
+                        StackEntry& next) {
   if (bits == 0) return false;
   const int i = __builtin_ctz(bits);
   bits &= bits - 1;
@@ -250,7 +256,8 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
 }
 
 // Any hit for one ray below `start` (a node, or a leaf pack when start.count > 0).
-HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar, StackEntry start) {
+HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar,
+                              StackEntry start) {
   const WideNode* nodes = bvh.nodes().data();
   const Triangle* tris = bvh.triangles().data();
   const TrianglePack* packs = bvh.packs().data();
@@ -309,8 +316,8 @@ HWY_INLINE WideRay LaneRay(const BundleState& st, int k) {
 constexpr int kBundleMinLanes = 8;
 
 // The lanes of `mask` whose rays hit a triangle of `pack`.
-HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t count, const Triangle* tris, const BundleState& st,
-                                         uint32_t mask) {
+HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t count, const Triangle* tris,
+                                         const BundleState& st, uint32_t mask) {
   uint32_t found = 0;
   for (uint32_t k = 0; k < count && mask; ++k) {
     const Vec3 v0{pack.v[0][0][k], pack.v[0][1][k], pack.v[0][2][k]};
@@ -369,7 +376,8 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
       if (std::popcount(lanes) < kBundleMinLanes) {
         for (uint32_t bits = lanes; bits; bits &= bits - 1) {
           const int k = __builtin_ctz(bits);
-          if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f})) found |= 1u << k;
+          if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f}))
+            found |= 1u << k;
         }
       } else if (e.count > 0) {
         found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
@@ -435,7 +443,9 @@ HWY_EXPORT(CurrentTarget);
 HWY_EXPORT(IntersectBrute);
 HWY_EXPORT(OccludedBrute);
 
-bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectBrute)(*this, ray, hit); }
+bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const {
+  return HWY_DYNAMIC_DISPATCH(IntersectBrute)(*this, ray, hit);
+}
 bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
 
 SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
@@ -610,7 +620,10 @@ std::string WideBvh::validate() const {
   std::vector<uint32_t> visits(nodes_.size(), 0);
   std::vector<uint32_t> stack{0};
   // Every triangle below a child must lie in that child's box; check leaf by leaf.
-  struct Pending { uint32_t node; Aabb box; };
+  struct Pending {
+    uint32_t node;
+    Aabb box;
+  };
   std::vector<Pending> work{{0, bounds_}};  // the root's children lie in the tree's bounds
   while (!work.empty()) {
     const Pending p = work.back();
@@ -653,14 +666,16 @@ std::string WideBvh::validate() const {
   }
   for (size_t i = 0; i < seen.size(); ++i) {
     const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
-    if (seen[i] != expected) return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
+    if (seen[i] != expected)
+      return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
   }
   for (size_t i = 0; i < visits.size(); ++i) {
     if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
   }
   if (node_place_.empty() || node_place_[0] != kNoPlace) return "the root has a parent";
   for (size_t i = 0; i < seen.size(); ++i) {
-    if (seen[i] == 0 && leaf_place_[i] != kNoPlace) return "degenerate triangle " + std::to_string(i) + " has a leaf place";
+    if (seen[i] == 0 && leaf_place_[i] != kNoPlace)
+      return "degenerate triangle " + std::to_string(i) + " has a leaf place";
   }
   return "";
 }

@@ -13,8 +13,8 @@
 
 #include <cmath>
 
-#include "accel/wide_bvh.hpp"
 #include "accel/lane_bits-inl.h"
+#include "accel/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -85,8 +85,8 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
 
 // Triangle `k` of `pack` against the lanes in `mask`, updating each lane's closest hit exactly
 // as intersect_range() does for one ray.
-HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, const uint32_t* ids, PacketState& st,
-                                        uint32_t mask) {
+HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, const uint32_t* ids,
+                                        PacketState& st, uint32_t mask) {
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
@@ -113,7 +113,9 @@ HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Tria
     const auto pos = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
     const auto det = hn::Add(hn::Add(u, v), w);
     const auto rcp = hn::Div(one, det);
-    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))), rcp);
+    const auto t = hn::Mul(
+        hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))),
+        rcp);
     const auto best_t = hn::Load(d, st.t + i);
     const auto best_id = hn::Load(di, st.tri + i);
     auto hit = hn::AndNot(hn::And(neg, pos), hn::Ne(det, zero));
@@ -270,7 +272,9 @@ namespace tracer {
 
 HWY_EXPORT(IntersectPacketWide);
 
-void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits) const { HWY_DYNAMIC_DISPATCH(IntersectPacketWide)(*this, rays, hits); }
+void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits) const {
+  HWY_DYNAMIC_DISPATCH(IntersectPacketWide)(*this, rays, hits);
+}
 
 }  // namespace tracer
 #endif  // HWY_ONCE

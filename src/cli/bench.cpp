@@ -20,14 +20,14 @@
 #include <thread>
 
 #include "accel/accelerator.hpp"
+#include "base/errors.hpp"
 #include "cli/parse.hpp"
 #include "io/image_io.hpp"
 #include "render/shading.hpp"
-#include "sched/scheduler.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
+#include "sched/scheduler.hpp"
 
 namespace tracer::cli {
 namespace {
@@ -49,23 +49,36 @@ struct Variant {
 const std::vector<Variant>& all_variants() {
   static const std::vector<Variant> v = {
       {"seq", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq, "brute force, one thread", true},
-      {"async", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Async, "brute force, std::async per row", true},
+      {"async", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Async, "brute force, std::async per row",
+       true},
       {"bvh", AccelKind::Bvh, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq, "median BVH, one thread", true},
       {"async+bvh", AccelKind::Bvh, BvhSplit::Median, BuildMode::Seq, SchedKind::Async, "median BVH, async rows", true},
-      {"async+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Async, "median BVH built with std::async, async rows", true},
-      {"lq+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Queue, "median BVH built with std::async, locked queue", true},
-      {"async+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Async, "median BVH built by a job queue, async rows", true},
-      {"lq+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Queue, "median BVH built by a job queue, locked queue", true},
+      {"async+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Async,
+       "median BVH built with std::async, async rows", true},
+      {"lq+bvh+parbuild-v1", AccelKind::Bvh, BvhSplit::Median, BuildMode::Async, SchedKind::Queue,
+       "median BVH built with std::async, locked queue", true},
+      {"async+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Async,
+       "median BVH built by a job queue, async rows", true},
+      {"lq+bvh+parbuild-v2", AccelKind::Bvh, BvhSplit::Median, BuildMode::Queue, SchedKind::Queue,
+       "median BVH built by a job queue, locked queue", true},
       {"lq", AccelKind::Brute, BvhSplit::Median, BuildMode::Seq, SchedKind::Queue, "brute force, locked queue", true},
-      {"simd-brute", AccelKind::BruteSimd, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq, "brute force, 8 triangles per SIMD test, one thread (the study's ISPC)", true},
+      {"simd-brute", AccelKind::BruteSimd, BvhSplit::Median, BuildMode::Seq, SchedKind::Seq,
+       "brute force, 8 triangles per SIMD test, one thread (the study's ISPC)", true},
       {"sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Seq, SchedKind::Seq, "SAH BVH, one thread", false},
-      {"async+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Async, "SAH BVH (TBB build), std::async per row", false},
-      {"lq+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Queue, "SAH BVH (TBB build), locked queue of 64-pixel blocks", false},
-      {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic, "SAH BVH (TBB build), atomic tile counter", false},
-      {"tbb+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "SAH BVH (TBB build), TBB work stealing", false},
-      {"bvh8", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), TBB work stealing", false},
-      {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "8-wide SIMD BVH (TBB build), primary-ray packets and AO bundles, TBB work stealing", false, true},
-      {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb, "Intel Embree 3, TBB work stealing", false},
+      {"async+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Async,
+       "SAH BVH (TBB build), std::async per row", false},
+      {"lq+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Queue,
+       "SAH BVH (TBB build), locked queue of 64-pixel blocks", false},
+      {"atomic+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Atomic,
+       "SAH BVH (TBB build), atomic tile counter", false},
+      {"tbb+sah", AccelKind::Bvh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "SAH BVH (TBB build), TBB work stealing", false},
+      {"bvh8", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "8-wide SIMD BVH (TBB build), TBB work stealing", false},
+      {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "8-wide SIMD BVH (TBB build), primary-ray packets and AO bundles, TBB work stealing", false, true},
+      {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "Intel Embree 3, TBB work stealing", false},
   };
   return v;
 }
@@ -73,10 +86,49 @@ const std::vector<Variant>& all_variants() {
 // The study's published milliseconds (4-core i7-7700HQ), for ratio comparison.
 const std::map<std::string, std::map<std::string, double>>& study_ms() {
   static const std::map<std::string, std::map<std::string, double>> m = {
-      {"Original", {{"seq", 9867.0}, {"async", 2271.0}, {"bvh", 4043.3}, {"async+bvh", 1034.0}, {"async+bvh+parbuild-v1", 1047.7}, {"lq+bvh+parbuild-v1", 1244.3}, {"async+bvh+parbuild-v2", 958.3}, {"lq+bvh+parbuild-v2", 1254.3}, {"lq", 2714.0}, {"simd-brute", 4476.0}}},
-      {"Mirror", {{"seq", 9865.0}, {"async", 2271.3}, {"bvh", 4037.0}, {"async+bvh", 1030.7}, {"async+bvh+parbuild-v1", 1052.7}, {"lq+bvh+parbuild-v1", 1243.3}, {"async+bvh+parbuild-v2", 958.7}, {"lq+bvh+parbuild-v2", 1253.0}, {"lq", 2713.0}, {"simd-brute", 4334.0}}},
-      {"Sphere", {{"seq", 463005.0}, {"async", 116098.0}, {"bvh", 3708.0}, {"async+bvh", 1078.0}, {"async+bvh+parbuild-v1", 1131.0}, {"lq+bvh+parbuild-v1", 1182.7}, {"async+bvh+parbuild-v2", 1016.3}, {"lq+bvh+parbuild-v2", 1147.3}, {"lq", 129371.3}, {"simd-brute", 150822.3}}},
-      {"Water", {{"seq", 1482647.0}, {"async", 373939.0}, {"bvh", 4489.0}, {"async+bvh", 1528.3}, {"async+bvh+parbuild-v1", 1747.7}, {"lq+bvh+parbuild-v1", 1638.0}, {"async+bvh+parbuild-v2", 1607.7}, {"lq+bvh+parbuild-v2", 1512.7}, {"lq", 417250.3}}},
+      {"Original",
+       {{"seq", 9867.0},
+        {"async", 2271.0},
+        {"bvh", 4043.3},
+        {"async+bvh", 1034.0},
+        {"async+bvh+parbuild-v1", 1047.7},
+        {"lq+bvh+parbuild-v1", 1244.3},
+        {"async+bvh+parbuild-v2", 958.3},
+        {"lq+bvh+parbuild-v2", 1254.3},
+        {"lq", 2714.0},
+        {"simd-brute", 4476.0}}},
+      {"Mirror",
+       {{"seq", 9865.0},
+        {"async", 2271.3},
+        {"bvh", 4037.0},
+        {"async+bvh", 1030.7},
+        {"async+bvh+parbuild-v1", 1052.7},
+        {"lq+bvh+parbuild-v1", 1243.3},
+        {"async+bvh+parbuild-v2", 958.7},
+        {"lq+bvh+parbuild-v2", 1253.0},
+        {"lq", 2713.0},
+        {"simd-brute", 4334.0}}},
+      {"Sphere",
+       {{"seq", 463005.0},
+        {"async", 116098.0},
+        {"bvh", 3708.0},
+        {"async+bvh", 1078.0},
+        {"async+bvh+parbuild-v1", 1131.0},
+        {"lq+bvh+parbuild-v1", 1182.7},
+        {"async+bvh+parbuild-v2", 1016.3},
+        {"lq+bvh+parbuild-v2", 1147.3},
+        {"lq", 129371.3},
+        {"simd-brute", 150822.3}}},
+      {"Water",
+       {{"seq", 1482647.0},
+        {"async", 373939.0},
+        {"bvh", 4489.0},
+        {"async+bvh", 1528.3},
+        {"async+bvh+parbuild-v1", 1747.7},
+        {"lq+bvh+parbuild-v1", 1638.0},
+        {"async+bvh+parbuild-v2", 1607.7},
+        {"lq+bvh+parbuild-v2", 1512.7},
+        {"lq", 417250.3}}},
   };
   return m;
 }
@@ -98,7 +150,8 @@ std::vector<SceneEntry> resolve_scenes(const std::string& spec) {
   std::vector<SceneEntry> out;
   for (const std::string& item : split_list("--scenes", spec)) {
     if (item == "cornell" || item == "all") {
-      for (const char* n : {"Original", "Mirror", "Sphere", "Water"}) out.push_back({n, dir + "/cornell-box/CornellBox-" + n + ".obj"});
+      for (const char* n : {"Original", "Mirror", "Sphere", "Water"})
+        out.push_back({n, dir + "/cornell-box/CornellBox-" + n + ".obj"});
     }
     if (item == "large" || item == "all") {
       out.push_back({"Sponza", dir + "/sponza/sponza.obj"});
@@ -205,8 +258,10 @@ std::string svg_chart(const std::vector<SceneEntry>& scenes, const std::vector<V
     << "' font-family='sans-serif' font-size='11'>\n<rect width='100%' height='100%' fill='white'/>\n";
   for (double e = l0; e <= l1; e += 1) {
     const int y = y_of(std::pow(10.0, e));
-    s << "<line x1='" << left << "' x2='" << left + int(scenes.size()) * group << "' y1='" << y << "' y2='" << y << "' stroke='#ddd'/>"
-      << "<text x='" << left - 6 << "' y='" << y + 4 << "' text-anchor='end'>" << fmt(std::pow(10.0, e), 0) << " ms</text>\n";
+    s << "<line x1='" << left << "' x2='" << left + int(scenes.size()) * group << "' y1='" << y << "' y2='" << y
+      << "' stroke='#ddd'/>"
+      << "<text x='" << left - 6 << "' y='" << y + 4 << "' text-anchor='end'>" << fmt(std::pow(10.0, e), 0)
+      << " ms</text>\n";
   }
   for (size_t si = 0; si < scenes.size(); ++si) {
     const int gx = left + int(si) * group + gap / 2;
@@ -214,18 +269,22 @@ std::string svg_chart(const std::vector<SceneEntry>& scenes, const std::vector<V
       const auto it = cells.find({scenes[si].name, variants[vi].name});
       if (it == cells.end() || it->second.timed_out || it->second.total_ms <= 0) continue;
       const int y = y_of(it->second.total_ms);
-      s << "<rect x='" << gx + int(vi) * bar << "' y='" << y << "' width='" << bar - 1 << "' height='" << top + height - y
-        << "' fill='hsl(" << (vi * 360 / variants.size()) << ",60%,50%)'><title>" << variants[vi].name << " on " << scenes[si].name
-        << ": " << fmt(it->second.total_ms) << " ms</title></rect>\n";
+      s << "<rect x='" << gx + int(vi) * bar << "' y='" << y << "' width='" << bar - 1 << "' height='"
+        << top + height - y << "' fill='hsl(" << (vi * 360 / variants.size()) << ",60%,50%)'><title>"
+        << variants[vi].name << " on " << scenes[si].name << ": " << fmt(it->second.total_ms) << " ms</title></rect>\n";
     }
-    s << "<text x='" << gx + int(variants.size()) * bar / 2 << "' y='" << top + height + 16 << "' text-anchor='middle'>" << scenes[si].name << "</text>\n";
+    s << "<text x='" << gx + int(variants.size()) * bar / 2 << "' y='" << top + height + 16 << "' text-anchor='middle'>"
+      << scenes[si].name << "</text>\n";
   }
   for (size_t vi = 0; vi < variants.size(); ++vi) {
     const int x = left + int(scenes.size()) * group + 20, y = top + int(vi) * 16;
-    s << "<rect x='" << x << "' y='" << y << "' width='10' height='10' fill='hsl(" << (vi * 360 / variants.size()) << ",60%,50%)'/>"
+    s << "<rect x='" << x << "' y='" << y << "' width='10' height='10' fill='hsl(" << (vi * 360 / variants.size())
+      << ",60%,50%)'/>"
       << "<text x='" << x + 16 << "' y='" << y + 9 << "'>" << variants[vi].name << "</text>\n";
   }
-  s << "<text x='" << left << "' y='16' font-size='13'>tracer bench: build + render time per scene and variant (log scale, k-best mean)</text>\n</svg>\n";
+  s << "<text x='" << left
+    << "' y='16' font-size='13'>tracer bench: build + render time per scene and variant (log scale, k-best "
+       "mean)</text>\n</svg>\n";
   return s.str();
 }
 
@@ -248,7 +307,8 @@ void add_bench_options(CLI::App& app, BenchArgs& a) {
 
 int run_bench(const BenchArgs& a) {
   if (a.list) {
-    for (const Variant& v : all_variants()) std::printf("%-24s %s%s\n", v.name.c_str(), v.description.c_str(), v.study ? " (study)" : "");
+    for (const Variant& v : all_variants())
+      std::printf("%-24s %s%s\n", v.name.c_str(), v.description.c_str(), v.study ? " (study)" : "");
     return 0;
   }
   const auto [width, height] = parse_size("--size", a.size);
@@ -284,11 +344,11 @@ int run_bench(const BenchArgs& a) {
       std::vector<double> builds, renders;
       for (int run = 0; run < a.runs && !cell.timed_out; ++run) {
         if (tty || run == 0) {  // logs get one line per cell
-        const double elapsed = std::chrono::duration<double>(Clock::now() - bench_start).count();
-        const double frac = (double(done_cells) + double(run) / a.runs) / double(total_cells);
-        std::fprintf(stderr, "%scell %zu/%zu %-10s %-24s run %2d/%d  elapsed %6.0fs  ETA %s%s", tty ? "\r" : "", done_cells + 1, total_cells,
-                     se.name.c_str(), v.name.c_str(), run + 1, a.runs, elapsed,
-                     frac > 0 ? (fmt(elapsed * (1 - frac) / frac, 0) + "s").c_str() : "?", tty ? "   " : "\n");
+          const double elapsed = std::chrono::duration<double>(Clock::now() - bench_start).count();
+          const double frac = (double(done_cells) + double(run) / a.runs) / double(total_cells);
+          std::fprintf(stderr, "%scell %zu/%zu %-10s %-24s run %2d/%d  elapsed %6.0fs  ETA %s%s", tty ? "\r" : "",
+                       done_cells + 1, total_cells, se.name.c_str(), v.name.c_str(), run + 1, a.runs, elapsed,
+                       frac > 0 ? (fmt(elapsed * (1 - frac) / frac, 0) + "s").c_str() : "?", tty ? "   " : "\n");
         }
         AccelOptions ao;
         ao.kind = v.accel;
@@ -354,14 +414,18 @@ int run_bench(const BenchArgs& a) {
     }
   };
   const std::string timeout_text = "> " + fmt(a.max_seconds, 0) + " s";
-  md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs << " runs, mean of best " << a.best
-     << ", threads " << resolve_thread_count(threads) << "\n";
+  md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs
+     << " runs, mean of best " << a.best << ", threads " << resolve_thread_count(threads) << "\n";
   header("Build + render time, ms (k-best mean)");
   row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? timeout_text : fmt(c.total_ms); });
   header("Build time, ms");
-  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? std::string("-") : fmt(c.build_ms, 2); });
+  row([&](const SceneEntry&, const Variant&, const Cell& c) {
+    return c.timed_out ? std::string("-") : fmt(c.build_ms, 2);
+  });
   header("Throughput, Mrays/s (render only)");
-  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? std::string("-") : fmt(c.mrays, 2); });
+  row([&](const SceneEntry&, const Variant&, const Cell& c) {
+    return c.timed_out ? std::string("-") : fmt(c.mrays, 2);
+  });
   const bool have_seq = std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "seq"; });
   if (have_seq) {
     header("Speedup over seq (same scene, same run)");
@@ -379,7 +443,8 @@ int run_bench(const BenchArgs& a) {
       return fmt(s.total_ms / c.total_ms, 1) + " / " + fmt(study_speedup, 1);
     });
   }
-  const bool have_embree = std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "embree"; });
+  const bool have_embree =
+      std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "embree"; });
   if (have_embree) {
     header("Throughput relative to Embree (Mrays/s ratio, same rays, same run)");
     row([&](const SceneEntry& se, const Variant&, const Cell& c) {
@@ -391,11 +456,23 @@ int run_bench(const BenchArgs& a) {
   std::cout << md.str();
   if (!a.markdown.empty()) write_file_atomic(a.markdown, md.str());
   if (!a.json.empty()) {
-    nlohmann::json j = {{"size", {width, height}}, {"ao", a.ao}, {"runs", a.runs}, {"best", a.best}, {"cells", nlohmann::json::array()}};
+    nlohmann::json j = {{"size", {width, height}},
+                        {"ao", a.ao},
+                        {"runs", a.runs},
+                        {"best", a.best},
+                        {"cells", nlohmann::json::array()}};
     for (const auto& [key, c] : cells) {
-      j["cells"].push_back({{"scene", c.scene}, {"variant", c.variant}, {"triangles", c.triangles}, {"timed_out", c.timed_out},
-                            {"load_ms", c.load_ms}, {"build_ms", c.build_ms}, {"render_ms", c.render_ms}, {"total_ms", c.total_ms},
-                            {"rays", c.rays}, {"mrays_per_s", c.mrays}, {"runs_ms", c.run_ms}});
+      j["cells"].push_back({{"scene", c.scene},
+                            {"variant", c.variant},
+                            {"triangles", c.triangles},
+                            {"timed_out", c.timed_out},
+                            {"load_ms", c.load_ms},
+                            {"build_ms", c.build_ms},
+                            {"render_ms", c.render_ms},
+                            {"total_ms", c.total_ms},
+                            {"rays", c.rays},
+                            {"mrays_per_s", c.mrays},
+                            {"runs_ms", c.run_ms}});
     }
     write_file_atomic(a.json, j.dump(2) + "\n");
   }

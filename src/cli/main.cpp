@@ -10,12 +10,12 @@
 #include <new>
 #include <sstream>
 
+#include "base/errors.hpp"
 #include "cli/bench.hpp"
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
 #include "cli/signals.hpp"
 #include "io/image_io.hpp"
-#include "base/errors.hpp"
 
 namespace tracer::cli {
 namespace {
@@ -25,8 +25,9 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // The run's statistics, for --stats (text) and --stats-json.
-nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel, const SchedOptions& sched,
-                            const RenderArgs& args, double load_ms, double render_ms, const RayCounts& rays) {
+nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
+                            const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
+                            const RayCounts& rays) {
   const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
   return {{"scene", scene.source},
           {"triangles", scene.size()},
@@ -49,14 +50,17 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   const auto str = [&](const char* k) { return j[k].get<std::string>(); };
   std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
-  std::printf("image        %dx%d, %d AO rays per hit -> %s\n", j["width"].get<int>(), j["height"].get<int>(), j["ao_samples"].get<int>(),
-              str("output").c_str());
+  std::printf("image        %dx%d, %d AO rays per hit -> %s\n", j["width"].get<int>(), j["height"].get<int>(),
+              j["ao_samples"].get<int>(), str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              j["packets"].get<bool>() ? (accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles" : ", AO rays in bundles") : "");
+              j["packets"].get<bool>()
+                  ? (accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles"
+                                                   : ", AO rays in bundles")
+                  : "");
   if (const std::optional<BvhStats> st = accel.bvh_stats()) {
-    std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n", st->nodes, st->leaves,
-                st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
+    std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n",
+                st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
   }
   std::printf("scheduler    %s, %d threads\n", str("sched").c_str(), j["threads"].get<int>());
   std::printf("load         %10.2f ms\n", j["load_ms"].get<double>());
@@ -64,7 +68,8 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
   const auto& r = j["rays"];
   std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu total\n", r["primary"].get<unsigned long long>(),
-              r["shadow"].get<unsigned long long>(), r["ao"].get<unsigned long long>(), r["total"].get<unsigned long long>());
+              r["shadow"].get<unsigned long long>(), r["ao"].get<unsigned long long>(),
+              r["total"].get<unsigned long long>());
   std::printf("throughput   %10.2f Mrays/s\n", j["mrays_per_s"].get<double>());
 }
 
@@ -97,7 +102,8 @@ int cmd_render(const RenderArgs& args) {
   const auto t_render = std::chrono::steady_clock::now();
   bool finished;
   {
-    ProgressBar progress(!args.quiet, uint64_t(settings.width) * uint64_t(settings.height), control.pixels_done, control.rays_done);
+    ProgressBar progress(!args.quiet, uint64_t(settings.width) * uint64_t(settings.height), control.pixels_done,
+                         control.rays_done);
     finished = render_image(accel, ctx, sched, control);
   }
   const double render_ms = ms_since(t_render);
@@ -106,16 +112,19 @@ int cmd_render(const RenderArgs& args) {
       write_image(args.output, tonemap(fb, settings.exposure));
       std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << args.output << "\n";
     } else {
-      std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "") << "; no image written\n";
+      std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
+                << "; no image written\n";
     }
     return exit_code_for_stop();
   }
   write_image(args.output, tonemap(fb, settings.exposure));
   if (stop_signal() != 0) {  // arrived during the final write, which is never torn
-    std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output << "\n";
+    std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output
+              << "\n";
     return exit_code_for_stop();
   }
-  const nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
+  const nlohmann::json stats =
+      render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
   if (args.stats) print_stats(stats, accel);
   if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
   return 0;
@@ -131,8 +140,8 @@ int cmd_info(const SceneArgs& args) {
   for (const Material& m : scene.materials) std::printf(" %s", m.name.c_str());
   std::printf("\nlights      %zu\n", scene.lights.size());
   for (const Light& l : scene.lights) {
-    std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x, l.position.y,
-                l.position.z, l.power.x, l.power.y, l.power.z);
+    std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x,
+                l.position.y, l.position.z, l.power.x, l.power.y, l.power.z);
   }
   std::printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", scene.bounds.lo.x, scene.bounds.lo.y, scene.bounds.lo.z,
               scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
@@ -156,7 +165,8 @@ int main(int argc, char** argv) {
   render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
   render->add_option("--stats-json", render_args.stats_json, "write the statistics as JSON to this file");
   render->add_flag("-q,--quiet", render_args.quiet, "no progress bar");
-  render->add_flag("--save-partial", render_args.save_partial, "on Ctrl-C, write the image with unfinished tiles black");
+  render->add_flag("--save-partial", render_args.save_partial,
+                   "on Ctrl-C, write the image with unfinished tiles black");
 
   SceneArgs info_args;
   CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");

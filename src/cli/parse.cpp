@@ -16,11 +16,17 @@ Vec3 parse_vec3(const std::string& flag, const std::string& text) {
   while (ok) {
     const size_t comma = text.find(',', pos);
     const std::string part = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    if (n == 3) { ok = false; break; }
+    if (n == 3) {
+      ok = false;
+      break;
+    }
     const char* b = part.data();
     const char* e = b + part.size();
     const auto [ptr, ec] = std::from_chars(b, e, v[n]);
-    if (part.empty() || ec != std::errc{} || ptr != e || !std::isfinite(v[n])) { ok = false; break; }
+    if (part.empty() || ec != std::errc{} || ptr != e || !std::isfinite(v[n])) {
+      ok = false;
+      break;
+    }
     ++n;
     if (comma == std::string::npos) break;
     pos = comma + 1;
@@ -32,7 +38,8 @@ Vec3 parse_vec3(const std::string& flag, const std::string& text) {
 Vec3 parse_point(const std::string& flag, const std::string& text) {
   const Vec3 p = parse_vec3(flag, text);
   for (const float c : {p.x, p.y, p.z}) {
-    if (std::fabs(c) > kMaxCoordinate) throw UsageError(flag + ": coordinates must lie within +-1e18, got '" + text + "'");
+    if (std::fabs(c) > kMaxCoordinate)
+      throw UsageError(flag + ": coordinates must lie within +-1e18, got '" + text + "'");
   }
   return p;
 }
@@ -46,7 +53,8 @@ std::pair<int, int> parse_size(const std::string& flag, const std::string& text)
     const char* e = b + parts[i].size();
     long long n = 0;
     const auto [ptr, ec] = std::from_chars(b, e, n);
-    if (parts[i].empty() || ec != std::errc{} || ptr != e) throw UsageError(flag + ": expected WxH (two whole numbers), got '" + text + "'");
+    if (parts[i].empty() || ec != std::errc{} || ptr != e)
+      throw UsageError(flag + ": expected WxH (two whole numbers), got '" + text + "'");
     check_range(flag + (i == 0 ? " width" : " height"), n, 1, 16384);
     v[i] = int(n);
   }
@@ -68,7 +76,8 @@ std::vector<std::string> split_list(const std::string& flag, const std::string& 
 
 void check_range(const std::string& flag, long long value, long long lo, long long hi) {
   if (value < lo || value > hi) {
-    throw UsageError(flag + ": must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + std::to_string(value));
+    throw UsageError(flag + ": must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " +
+                     std::to_string(value));
   }
 }
 

@@ -34,7 +34,8 @@ void ProgressBar::run() {
     char bar[kWidth + 1];
     for (int i = 0; i < kWidth; ++i) bar[i] = i < int(frac * kWidth) ? '#' : '.';
     bar[kWidth] = '\0';
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs  %8.2f Mrays/s", bar, frac * 100.0, elapsed, eta, mrays);
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs  %8.2f Mrays/s", bar, frac * 100.0, elapsed, eta,
+                 mrays);
     std::fflush(stderr);
     drawn_ = true;
     if (cv_.wait_for(lock, milliseconds(200), [this] { return stopping_; })) break;

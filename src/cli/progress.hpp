@@ -13,7 +13,8 @@ namespace tracer::cli {
 
 class ProgressBar {
  public:
-  ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels, const std::atomic<uint64_t>& rays);
+  ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels,
+              const std::atomic<uint64_t>& rays);
   ~ProgressBar() { stop(); }
   void stop();
 

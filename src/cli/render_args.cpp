@@ -4,11 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "base/errors.hpp"
 #include "cli/parse.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "base/errors.hpp"
 #include "scene/obj_loader.hpp"
 
 namespace tracer::cli {
@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 
 void add_scene_options(CLI::App& app, SceneArgs& a) {
   app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)");
-  app.add_option("--builtin-spheres", a.builtin_spheres, "built-in scene: add two spheres of about this many triangles each");
+  app.add_option("--builtin-spheres", a.builtin_spheres,
+                 "built-in scene: add two spheres of about this many triangles each");
   app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
   app.add_flag("--no-scene-lights", a.no_scene_lights, "drop the scene's emissive lights, keep only --light ones");
   app.add_option("--light-intensity", a.light_intensity, "point light intensity (default: (scene diagonal / 2)^2)");
@@ -41,11 +42,16 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
   app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
   app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
-  app.add_option("--traversal-cost", a.traversal_cost, "SAH BVH: cost of a node step relative to a triangle test (0-100)")
+  app.add_option("--traversal-cost", a.traversal_cost,
+                 "SAH BVH: cost of a node step relative to a triangle test (0-100)")
       ->capture_default_str();
-  app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")->capture_default_str();
-  app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")->capture_default_str();
-  app.add_flag("--packets", a.packets, "trace rays together: each hit's AO rays as one bundle (bvh, bvh8), primary rays in 4x4-pixel packets (bvh8); same image");
+  app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")
+      ->capture_default_str();
+  app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")
+      ->capture_default_str();
+  app.add_flag("--packets", a.packets,
+               "trace rays together: each hit's AO rays as one bundle (bvh, bvh8), primary rays in 4x4-pixel packets "
+               "(bvh8); same image");
   app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
@@ -116,7 +122,8 @@ void check_outputs(const RenderArgs& a) {
 
 Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
   const WarningSink silent = [](const std::string&) {};
-  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, quiet ? silent : WarningSink{}, cancel);
+  Scene scene =
+      a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, quiet ? silent : WarningSink{}, cancel);
   if (a.no_scene_lights) scene.lights.clear();
   const float diag = length(scene.bounds.extent());
   const float intensity = a.light_intensity ? float(*a.light_intensity) : 0.25f * diag * diag;
@@ -133,9 +140,11 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
   const float fov = a.fov ? float(*a.fov) : kDefaultFovDegrees;
   const Vec3 extent = scene.bounds.extent();
   if (a.eye.empty() && a.look.empty() && !scene.camera && std::max({extent.x, extent.y, extent.z}) == 0.0f) {
-    throw InputError(scene.source + ": all vertices coincide, so there is nothing to frame (every triangle is degenerate)");
+    throw InputError(scene.source +
+                     ": all vertices coincide, so there is nothing to frame (every triangle is degenerate)");
   }
-  CameraSpec spec = scene.camera && a.eye.empty() && a.look.empty() && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
+  CameraSpec spec =
+      scene.camera && a.eye.empty() && a.look.empty() && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
   if (!a.eye.empty()) {
     spec.eye = parse_point("--eye", a.eye);
     if (a.look.empty()) spec.look = scene.bounds.center();
@@ -170,22 +179,36 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   const std::string accel = lower(a.accel);
   const std::string simd = lower(a.simd);
   if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
-  if (accel == "brute") o.kind = simd == "auto" ? AccelKind::BruteSimd : AccelKind::Brute;
-  else if (accel == "bvh") o.kind = AccelKind::Bvh;
-  else if (accel == "bvh8" && simd == "off") throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
-  else if (accel == "bvh8") o.kind = AccelKind::Bvh8;
-  else if (accel == "embree") o.kind = AccelKind::Embree;
-  else throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, bvh8, embree)");
+  if (accel == "brute")
+    o.kind = simd == "auto" ? AccelKind::BruteSimd : AccelKind::Brute;
+  else if (accel == "bvh")
+    o.kind = AccelKind::Bvh;
+  else if (accel == "bvh8" && simd == "off")
+    throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
+  else if (accel == "bvh8")
+    o.kind = AccelKind::Bvh8;
+  else if (accel == "embree")
+    o.kind = AccelKind::Embree;
+  else
+    throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, bvh8, embree)");
   const std::string split = lower(a.split);
-  if (split == "sah") o.bvh.split = BvhSplit::Sah;
-  else if (split == "median") o.bvh.split = BvhSplit::Median;
-  else throw UsageError("--bvh-split: unknown split '" + a.split + "' (sah, median)");
+  if (split == "sah")
+    o.bvh.split = BvhSplit::Sah;
+  else if (split == "median")
+    o.bvh.split = BvhSplit::Median;
+  else
+    throw UsageError("--bvh-split: unknown split '" + a.split + "' (sah, median)");
   const std::string build = lower(a.build);
-  if (build == "seq") o.bvh.mode = BuildMode::Seq;
-  else if (build == "async") o.bvh.mode = BuildMode::Async;
-  else if (build == "queue") o.bvh.mode = BuildMode::Queue;
-  else if (build == "tasks") o.bvh.mode = BuildMode::Tasks;
-  else throw UsageError("--build: unknown builder '" + a.build + "' (seq, async, queue, tasks)");
+  if (build == "seq")
+    o.bvh.mode = BuildMode::Seq;
+  else if (build == "async")
+    o.bvh.mode = BuildMode::Async;
+  else if (build == "queue")
+    o.bvh.mode = BuildMode::Queue;
+  else if (build == "tasks")
+    o.bvh.mode = BuildMode::Tasks;
+  else
+    throw UsageError("--build: unknown builder '" + a.build + "' (seq, async, queue, tasks)");
   o.bvh.threads = a.threads.value_or(0);
   o.bvh.max_leaf = a.max_leaf;
   o.bvh.bins = a.bins;

@@ -10,8 +10,8 @@
 
 #include "accel/accelerator.hpp"
 #include "render/shading.hpp"
-#include "sched/scheduler.hpp"
 #include "scene/scene.hpp"
+#include "sched/scheduler.hpp"
 
 namespace tracer::cli {
 

@@ -37,9 +37,12 @@ int exit_code_for_stop() { return 128 + stop_signal(); }
 
 const char* stop_signal_name() {
   switch (stop_signal()) {
-    case SIGTERM: return "terminated";
-    case SIGHUP: return "hung up";
-    default: return "interrupted";
+    case SIGTERM:
+      return "terminated";
+    case SIGHUP:
+      return "hung up";
+    default:
+      return "interrupted";
   }
 }
 

@@ -10,8 +10,8 @@ namespace tracer::cli {
 
 void install_stop_handlers();
 const std::atomic<bool>& stop_requested();
-int stop_signal();                       // the first signal received, 0 if none
-int exit_code_for_stop();                // 128 + stop_signal()
-const char* stop_signal_name();          // "interrupted", "terminated", "hung up"
+int stop_signal();               // the first signal received, 0 if none
+int exit_code_for_stop();        // 128 + stop_signal()
+const char* stop_signal_name();  // "interrupted", "terminated", "hung up"
 
 }  // namespace tracer::cli

@@ -50,7 +50,8 @@ void check_writable(const std::string& path) {
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw InputError(path + ": cannot write: directory '" + dir.string() + "' does not exist");
+  if (!fs::is_directory(dir, ec))
+    throw InputError(path + ": cannot write: directory '" + dir.string() + "' does not exist");
   if (::access(dir.c_str(), W_OK) != 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
   if (fs::is_directory(path, ec)) throw InputError(path + ": cannot write: is a directory");
 }
@@ -87,7 +88,9 @@ void write_image(const std::string& path, const Image8& image) {
     bytes = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
     bytes.append(reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
   } else {
-    const auto sink = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size)); };
+    const auto sink = [](void* ctx, void* data, int size) {
+      static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size));
+    };
     if (!stbi_write_png_to_func(sink, &bytes, image.width, image.height, 3, image.rgb.data(), image.width * 3)) {
       throw InputError(path + ": PNG encoding failed");
     }

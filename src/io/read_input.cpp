@@ -13,13 +13,20 @@ namespace {
 
 std::string reason(int err) {
   switch (err) {
-    case ENOENT: return "no such file";
-    case EACCES: return "permission denied";
-    case ELOOP: return "too many levels of symbolic links (a link loop?)";
-    case ENOTDIR: return "a component of the path is not a directory";
-    case EISDIR: return "is a directory";
-    case ENAMETOOLONG: return "file name too long";
-    default: return std::strerror(err);
+    case ENOENT:
+      return "no such file";
+    case EACCES:
+      return "permission denied";
+    case ELOOP:
+      return "too many levels of symbolic links (a link loop?)";
+    case ENOTDIR:
+      return "a component of the path is not a directory";
+    case EISDIR:
+      return "is a directory";
+    case ENAMETOOLONG:
+      return "file name too long";
+    default:
+      return std::strerror(err);
   }
 }
 

@@ -22,12 +22,12 @@ namespace tracer {
 struct RenderSettings {
   int width = 1024;
   int height = 1024;
-  int ao_samples = 16;           // 0 turns ambient occlusion off (the ambient term is then unoccluded)
-  float ao_distance = kInfinity; // tfar of the AO rays
-  float ambient = 0.25f;         // ambient light, times Kd and the unoccluded AO fraction
-  float exposure = 1.5f;         // tone-mapping exposure
+  int ao_samples = 16;            // 0 turns ambient occlusion off (the ambient term is then unoccluded)
+  float ao_distance = kInfinity;  // tfar of the AO rays
+  float ambient = 0.25f;          // ambient light, times Kd and the unoccluded AO fraction
+  float exposure = 1.5f;          // tone-mapping exposure
   uint32_t seed = 0;
-  bool packets = false;          // primary rays in 4x4-pixel packets (accelerators that have them)
+  bool packets = false;  // primary rays in 4x4-pixel packets (accelerators that have them)
 };
 
 struct RayCounts {
@@ -79,11 +79,15 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
 
 // Accelerators that trace a RayPacket at once (the 8-wide BVH).
 template <class A>
-concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) { a.intersect_packet(p, h); };
+concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) {
+  a.intersect_packet(p, h);
+};
 
 // Accelerators that answer the AO rays of one shading point as one bundle (both BVHs).
 template <class A>
-concept BundleAccelerator = requires(const A& a, const RayBundle& b) { a.occluded_bundle_from(b, 0u); };
+concept BundleAccelerator = requires(const A& a, const RayBundle& b) {
+  a.occluded_bundle_from(b, 0u);
+};
 
 // An occlusion query for a ray leaving scene triangle `origin`: accelerators that can start the
 // search at that triangle's leaf (the binary BVH) do; the others search from the root.
@@ -98,7 +102,8 @@ bool occluded_leaving(const Accel& accel, const Ray& ray, uint32_t origin) {
 
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
 template <class Accel>
-Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit, RayCounts& counts) {
+Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
+               RayCounts& counts) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
   if (!hit.valid()) return Vec3{0.0f};

@@ -30,13 +30,15 @@ IndexedMesh make_uv_sphere(Vec3 center, float radius, int slices, int stacks) {
       m.indices.insert(m.indices.end(), {ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
     }
   }
-  for (int j = 0; j < slices; ++j) m.indices.insert(m.indices.end(), {ring(stacks - 1, j), south, ring(stacks - 1, j + 1)});
+  for (int j = 0; j < slices; ++j)
+    m.indices.insert(m.indices.end(), {ring(stacks - 1, j), south, ring(stacks - 1, j + 1)});
   return m;
 }
 
 IndexedMesh make_box(Vec3 lo, Vec3 hi) {
   IndexedMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  for (int i = 0; i < 8; ++i)
+    m.vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
   // Each face as two counter-clockwise triangles seen from outside.
   const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
@@ -53,7 +55,8 @@ Vec3 mm(float x, float y, float z) { return Vec3{x, y, z} * kScale; }
 void add_quads(Scene& s, const std::string& name, std::initializer_list<Vec3> corners, uint32_t material) {
   IndexedMesh m;
   m.vertices.assign(corners.begin(), corners.end());
-  for (uint32_t q = 0; q + 3 < m.vertices.size(); q += 4) m.indices.insert(m.indices.end(), {q, q + 1, q + 2, q, q + 2, q + 3});
+  for (uint32_t q = 0; q + 3 < m.vertices.size(); q += 4)
+    m.indices.insert(m.indices.end(), {q, q + 1, q + 2, q, q + 2, q + 3});
   s.add_mesh(name, m.vertices, m.indices, material);
 }
 
@@ -72,24 +75,23 @@ Scene make_cornell_box(int sphere_triangles) {
   };
   add_quads(s, "floor", {mm(552.8f, 0, 0), mm(0, 0, 0), mm(0, 0, 559.2f), mm(549.6f, 0, 559.2f)}, 0);
   add_quads(s, "ceiling", {mm(556, 548.8f, 0), mm(556, 548.8f, 559.2f), mm(0, 548.8f, 559.2f), mm(0, 548.8f, 0)}, 0);
-  add_quads(s, "back_wall", {mm(549.6f, 0, 559.2f), mm(0, 0, 559.2f), mm(0, 548.8f, 559.2f), mm(556, 548.8f, 559.2f)}, 0);
+  add_quads(s, "back_wall", {mm(549.6f, 0, 559.2f), mm(0, 0, 559.2f), mm(0, 548.8f, 559.2f), mm(556, 548.8f, 559.2f)},
+            0);
   add_quads(s, "green_wall", {mm(0, 0, 559.2f), mm(0, 0, 0), mm(0, 548.8f, 0), mm(0, 548.8f, 559.2f)}, 2);
   add_quads(s, "red_wall", {mm(552.8f, 0, 0), mm(549.6f, 0, 559.2f), mm(556, 548.8f, 559.2f), mm(556, 548.8f, 0)}, 1);
   // The lamp hangs 0.1 mm below the ceiling so it is not coplanar with it.
   add_quads(s, "light", {mm(343, 548.7f, 227), mm(343, 548.7f, 332), mm(213, 548.7f, 332), mm(213, 548.7f, 227)}, 3);
   add_quads(s, "short_block",
-            {mm(130, 165, 65), mm(82, 165, 225), mm(240, 165, 272), mm(290, 165, 114),
-             mm(290, 0, 114), mm(290, 165, 114), mm(240, 165, 272), mm(240, 0, 272),
-             mm(130, 0, 65), mm(130, 165, 65), mm(290, 165, 114), mm(290, 0, 114),
-             mm(82, 0, 225), mm(82, 165, 225), mm(130, 165, 65), mm(130, 0, 65),
-             mm(240, 0, 272), mm(240, 165, 272), mm(82, 165, 225), mm(82, 0, 225)},
+            {mm(130, 165, 65),  mm(82, 165, 225),  mm(240, 165, 272), mm(290, 165, 114), mm(290, 0, 114),
+             mm(290, 165, 114), mm(240, 165, 272), mm(240, 0, 272),   mm(130, 0, 65),    mm(130, 165, 65),
+             mm(290, 165, 114), mm(290, 0, 114),   mm(82, 0, 225),    mm(82, 165, 225),  mm(130, 165, 65),
+             mm(130, 0, 65),    mm(240, 0, 272),   mm(240, 165, 272), mm(82, 165, 225),  mm(82, 0, 225)},
             0);
   add_quads(s, "tall_block",
-            {mm(423, 330, 247), mm(265, 330, 296), mm(314, 330, 456), mm(472, 330, 406),
-             mm(423, 0, 247), mm(423, 330, 247), mm(472, 330, 406), mm(472, 0, 406),
-             mm(472, 0, 406), mm(472, 330, 406), mm(314, 330, 456), mm(314, 0, 456),
-             mm(314, 0, 456), mm(314, 330, 456), mm(265, 330, 296), mm(265, 0, 296),
-             mm(265, 0, 296), mm(265, 330, 296), mm(423, 330, 247), mm(423, 0, 247)},
+            {mm(423, 330, 247), mm(265, 330, 296), mm(314, 330, 456), mm(472, 330, 406), mm(423, 0, 247),
+             mm(423, 330, 247), mm(472, 330, 406), mm(472, 0, 406),   mm(472, 0, 406),   mm(472, 330, 406),
+             mm(314, 330, 456), mm(314, 0, 456),   mm(314, 0, 456),   mm(314, 330, 456), mm(265, 330, 296),
+             mm(265, 0, 296),   mm(265, 0, 296),   mm(265, 330, 296), mm(423, 330, 247), mm(423, 0, 247)},
             0);
   if (sphere_triangles > 0) {
     // 2*slices*(stacks-1) triangles with slices = 2*stacks: pick stacks to match the request.

@@ -84,7 +84,9 @@ void lint_obj_text(std::string_view text, const std::string& name, CancelFlag ca
         parse_coordinate(tok, name, line_no);
       }
       if (n < needed) {
-        fail_at(name, line_no, "'" + std::string(keyword) + "' needs " + std::to_string(needed) + " numbers, got " + std::to_string(n));
+        fail_at(
+            name, line_no,
+            "'" + std::string(keyword) + "' needs " + std::to_string(needed) + " numbers, got " + std::to_string(n));
       }
       ++counts[keyword == "v" ? 0 : (keyword == "vt" ? 1 : 2)];
     } else if (keyword == "f") {
@@ -101,8 +103,9 @@ void lint_obj_text(std::string_view text, const std::string& name, CancelFlag ca
           const auto count = static_cast<long long>(counts[slot]);
           if (index == 0 || index > count || index < -count) {
             static const char* kinds[3] = {"vertex", "texture coordinate", "normal"};
-            fail_at(name, line_no, std::string(kinds[slot]) + " index " + std::to_string(index) + " out of range (" +
-                                       std::to_string(count) + " defined so far)");
+            fail_at(name, line_no,
+                    std::string(kinds[slot]) + " index " + std::to_string(index) + " out of range (" +
+                        std::to_string(count) + " defined so far)");
           }
         }
       }
@@ -162,7 +165,8 @@ class MtlSource : public tinyobj::MaterialReader {
   }
 
  private:
-  MtlSource(fs::path dir, std::string text, bool in_memory) : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory) {}
+  MtlSource(fs::path dir, std::string text, bool in_memory)
+      : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory) {}
   fs::path dir_;
   std::string text_;
   bool in_memory_;
@@ -270,7 +274,8 @@ Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, War
 
 // Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
 // finite and within range, every face index inside the vertex array, material ids in range.
-Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings, CancelFlag cancel) {
+Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings,
+                  CancelFlag cancel) {
   const tinyobj::attrib_t& attrib = parsed.attrib;
   Scene scene;
   scene.source = name;
@@ -278,14 +283,16 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   for (size_t i = 0; i < attrib.vertices.size(); ++i) {
     const float c = attrib.vertices[i];
     if (!std::isfinite(c) || std::fabs(c) > kMaxCoordinate) {
-      throw InputError(name + ": vertex " + std::to_string(i / 3 + 1) + " has a coordinate out of range (" + std::to_string(c) + ")");
+      throw InputError(name + ": vertex " + std::to_string(i / 3 + 1) + " has a coordinate out of range (" +
+                       std::to_string(c) + ")");
     }
   }
 
   size_t missing_textures = 0;
   std::string first_missing;
   for (const tinyobj::material_t& m : parsed.materials) {
-    for (const std::string* tex : {&m.diffuse_texname, &m.ambient_texname, &m.specular_texname, &m.bump_texname, &m.alpha_texname}) {
+    for (const std::string* tex :
+         {&m.diffuse_texname, &m.ambient_texname, &m.specular_texname, &m.bump_texname, &m.alpha_texname}) {
       std::error_code ec;
       if (!tex->empty() && !fs::exists(base_dir / *tex, ec)) {
         if (missing_textures++ == 0) first_missing = *tex;
@@ -294,8 +301,8 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     scene.materials.push_back(to_material(m, name));
   }
   if (missing_textures > 0) {
-    warnings.add(std::to_string(missing_textures) + " texture reference(s) not found (first: " + in_quotes(first_missing) +
-                 "); using material colours");
+    warnings.add(std::to_string(missing_textures) +
+                 " texture reference(s) not found (first: " + in_quotes(first_missing) + "); using material colours");
   }
   const auto default_material = static_cast<uint32_t>(scene.materials.size());
   bool used_default = false;
@@ -311,12 +318,14 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
       if (++faces_seen % kCancelStride == 0) throw_if_cancelled(cancel);
       const size_t fv = mesh.num_face_vertices[f];
-      if (offset + fv > mesh.indices.size()) throw InputError(name + ": face " + std::to_string(faces_seen) + " is incomplete");
+      if (offset + fv > mesh.indices.size())
+        throw InputError(name + ": face " + std::to_string(faces_seen) + " is incomplete");
       if (fv == 3) {
         Vec3 p[3];
         for (size_t k = 0; k < 3; ++k) {
           const auto vi = static_cast<size_t>(mesh.indices[offset + k].vertex_index);
-          if (vi >= scene.vertex_count) throw InputError(name + ": face " + std::to_string(faces_seen) + " has a vertex index out of range");
+          if (vi >= scene.vertex_count)
+            throw InputError(name + ": face " + std::to_string(faces_seen) + " has a vertex index out of range");
           p[k] = {attrib.vertices[3 * vi], attrib.vertices[3 * vi + 1], attrib.vertices[3 * vi + 2]};
         }
         const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
@@ -344,8 +353,8 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
 
 void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
-Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl, const WarningSink& warn_in,
-           CancelFlag cancel) {
+Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
+           const WarningSink& warn_in, CancelFlag cancel) {
   const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
   strip_bom(text);
   WarningLog warnings;
@@ -364,7 +373,8 @@ Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag canc
               MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir), warn, cancel);
 }
 
-Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name, const WarningSink& warn) {
+Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
+                           const WarningSink& warn) {
   std::string text = obj_text;
   return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr);
 }

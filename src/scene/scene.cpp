@@ -13,8 +13,8 @@ bool Triangle::degenerate() const {
   return cx == 0.0 && cy == 0.0 && cz == 0.0;
 }
 
-void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
-                     const std::vector<uint32_t>& indices, uint32_t material) {
+void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
+                     uint32_t material) {
   Geometry g;
   g.name = name;
   g.first_triangle = static_cast<uint32_t>(triangles.size());
@@ -39,7 +39,11 @@ void Scene::finalize() {
   }
   // One area light per (geometry, emissive material): the Cornell lamp is one quad, one light.
   std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
-  struct Accum { Vec3 weighted_centroid, normal; float area = 0; Vec3 ke; };
+  struct Accum {
+    Vec3 weighted_centroid, normal;
+    float area = 0;
+    Vec3 ke;
+  };
   std::map<std::pair<uint32_t, uint32_t>, Accum> emitters;
   for (size_t i = 0; i < triangles.size(); ++i) {
     const Material& m = materials[tri_material[i]];

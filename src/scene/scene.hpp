@@ -79,8 +79,8 @@ struct Scene {
 
   size_t size() const { return triangles.size(); }
   // Appends a geometry from an indexed mesh; material is an index into `materials`.
-  void add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
-                const std::vector<uint32_t>& indices, uint32_t material);
+  void add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
+                uint32_t material);
   // Recomputes bounds, degenerate count and the area lights from emissive materials.
   void finalize();
 };

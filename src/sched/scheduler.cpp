@@ -100,13 +100,24 @@ void render_tbb(const Accelerator& accel, const RenderContext& ctx, const SchedO
 
 }  // namespace
 
-bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options, RenderControl& control) {
+bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
+                  RenderControl& control) {
   switch (options.kind) {
-    case SchedKind::Seq: render_seq(accel, ctx, control); break;
-    case SchedKind::Async: render_async(accel, ctx, control); break;
-    case SchedKind::Queue: render_queue(accel, ctx, options, control); break;
-    case SchedKind::Atomic: render_atomic(accel, ctx, options, control); break;
-    case SchedKind::Tbb: render_tbb(accel, ctx, options, control); break;
+    case SchedKind::Seq:
+      render_seq(accel, ctx, control);
+      break;
+    case SchedKind::Async:
+      render_async(accel, ctx, control);
+      break;
+    case SchedKind::Queue:
+      render_queue(accel, ctx, options, control);
+      break;
+    case SchedKind::Atomic:
+      render_atomic(accel, ctx, options, control);
+      break;
+    case SchedKind::Tbb:
+      render_tbb(accel, ctx, options, control);
+      break;
   }
   (void)control.pixels_done.load(std::memory_order_acquire);
   return !control.cancelled();
@@ -123,11 +134,16 @@ SchedKind parse_sched(const std::string& name) {
 
 std::string to_string(SchedKind kind) {
   switch (kind) {
-    case SchedKind::Seq: return "seq";
-    case SchedKind::Async: return "async";
-    case SchedKind::Queue: return "queue";
-    case SchedKind::Atomic: return "atomic";
-    case SchedKind::Tbb: return "tbb";
+    case SchedKind::Seq:
+      return "seq";
+    case SchedKind::Async:
+      return "async";
+    case SchedKind::Queue:
+      return "queue";
+    case SchedKind::Atomic:
+      return "atomic";
+    case SchedKind::Tbb:
+      return "tbb";
   }
   return "?";
 }

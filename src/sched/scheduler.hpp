@@ -35,13 +35,14 @@ struct RenderControl {
   std::atomic<uint64_t> pixels_done{0};
   std::atomic<uint64_t> rays_done{0};
   AtomicRayCounts counts;
-  std::function<void(const Tile&)> on_tile;     // test hook, called once per rendered tile
+  std::function<void(const Tile&)> on_tile;  // test hook, called once per rendered tile
   bool cancelled() const { return is_cancelled(cancel); }
 };
 
 // Renders ctx.framebuffer with `accel`. Returns false if cancelled before finishing (tiles not
 // reached are left untouched).
-bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options, RenderControl& control);
+bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
+                  RenderControl& control);
 
 SchedKind parse_sched(const std::string& name);  // throws UsageError
 std::string to_string(SchedKind kind);

@@ -22,7 +22,8 @@ inline int resolve_thread_count(int threads) {
 class ThreadLimit {
  public:
   explicit ThreadLimit(int threads)
-      : control_(threads > 0 ? std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads))
+      : control_(threads > 0 ? std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                                     size_t(threads))
                              : nullptr) {}
   // True when more threads were asked for than the process may use: they time-share its cores.
   static bool oversubscribed(int threads) { return threads > resolve_thread_count(0); }
