@@ -6,9 +6,9 @@
 
 #include "accel/accelerator.hpp"
 #include "io/image_io.hpp"
+#include "render/render_image.hpp"
 #include "render/shading.hpp"
 #include "scene/builtin.hpp"
-#include "sched/scheduler.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

@@ -6,10 +6,10 @@
 #include <mutex>
 
 #include "accel/accelerator.hpp"
+#include "render/render_image.hpp"
 #include "render/shading.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
-#include "sched/scheduler.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -81,7 +81,8 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
           so.threads = threads;
           so.tile = tile;
           so.block = tile * 4;
-          SCOPED_TRACE(to_string(kind) + " threads " + std::to_string(threads) + " tile " + std::to_string(tile));
+          SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)) + " threads " + std::to_string(threads) +
+                       " tile " + std::to_string(tile));
           const Rendered r = render_with(scene, acc, so, size);
           EXPECT_EQ(r.rgb, reference.rgb);
           EXPECT_EQ(r.counts.total(), reference.counts.total());
@@ -113,7 +114,7 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
         so.tile = 7;
         so.block = 30;
         static const char* names[] = {" bvh8 single rays", " bvh8 packets", " bvh bundles"};
-        SCOPED_TRACE(to_string(kind) + names[variant]);
+        SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)) + names[variant]);
         const Rendered r = render_with(scene, variant == 2 ? binary : wide, so, size, packets);
         EXPECT_EQ(r.rgb, reference.rgb);
         EXPECT_EQ(r.counts.total(), reference.counts.total());
@@ -126,7 +127,7 @@ TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
   const Scene scene = make_cornell_box(0);
   const Accelerator acc = build_accelerator(scene, AccelOptions{});
   for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
-    SCOPED_TRACE(to_string(kind));
+    SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)));
     RenderSettings s;
     s.width = s.height = 64;
     s.ao_samples = 1;
@@ -144,6 +145,33 @@ TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
     so.threads = 2;
     EXPECT_FALSE(render_image(acc, ctx, so, control));
     EXPECT_LT(control.pixels_done.load(), uint64_t(s.width) * uint64_t(s.height));
+  }
+}
+
+TEST(ParallelForTiles, EveryPixelExactlyOnceWithEveryStrategy) {
+  // The loop knows nothing of rendering: count how often each pixel's tile is handed out.
+  constexpr int kW = 97, kH = 61;  // not multiples of any tile or block size
+  for (const EnumName<SchedKind>& e : kSchedKindNames) {
+    for (const int threads : {1, 3}) {
+      SCOPED_TRACE(std::string(e.name) + " threads " + std::to_string(threads));
+      SchedOptions so;
+      so.kind = e.value;
+      so.threads = threads;
+      so.tile = 8;
+      so.block = 20;
+      std::vector<std::atomic<int>> visits(kW * kH);
+      std::atomic<size_t> calls{0};
+      EXPECT_TRUE(parallel_for_tiles(kW, kH, so, nullptr, [&](const Tile& t) {
+        ++calls;
+        for (int y = t.y0; y < t.y1; ++y) {
+          for (int x = t.x0; x < t.x1; ++x) visits[size_t(y) * kW + size_t(x)]++;
+        }
+      }));
+      EXPECT_EQ(calls.load(), tiles_for(kW, kH, so).size());
+      size_t wrong = 0;
+      for (const auto& v : visits) wrong += v.load() != 1;
+      EXPECT_EQ(wrong, 0u);
+    }
   }
 }
 

@@ -26,6 +26,9 @@ concept RayAccelerator = requires(const A& a, const Ray& r, Hit& h) {
 };
 
 enum class AccelKind { Brute, BruteSimd, Bvh, Bvh8, Embree };
+// The names --accel takes: "brute" is BruteSimd unless --simd off asks for the scalar Brute.
+inline constexpr EnumName<AccelKind> kAccelKindNames[] = {
+    {AccelKind::BruteSimd, "brute"}, {AccelKind::Bvh, "bvh"}, {AccelKind::Bvh8, "bvh8"}, {AccelKind::Embree, "embree"}};
 
 struct AccelOptions {
   AccelKind kind = AccelKind::Bvh;

@@ -128,7 +128,7 @@ bool Bvh::occluded(const Ray& ray) const {
 }
 
 bool Bvh::occluded_from(const Ray& ray, uint32_t origin) const {
-  if (origin >= leaf_of_.size() || leaf_of_[origin] == kNoLeaf) return occluded(ray);
+  if (origin >= leaf_of_.size() || leaf_of_[origin] == kInvalidIndex) return occluded(ray);
   const RayShear shear(ray);
   const RayBoxTest box(ray);
   // A ray that misses the scene's box (leaving an outer surface outwards) is answered at once,
@@ -225,7 +225,7 @@ std::string Bvh::validate() const {
   }
   for (size_t i = 0; i < seen.size(); ++i) {
     const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
-    if (expected == 0 && leaf_of_.size() == seen.size() && leaf_of_[i] != kNoLeaf)
+    if (expected == 0 && leaf_of_.size() == seen.size() && leaf_of_[i] != kInvalidIndex)
       return "degenerate triangle " + std::to_string(i) + " has a leaf";
     if (seen[i] != expected) {
       err << "triangle " << i << " appears in " << seen[i] << " leaves, expected " << expected;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accel/triangle_test.hpp"
+#include "base/enum_names.hpp"
 #include "base/errors.hpp"
 #include "math/aabb.hpp"
 #include "math/ray_packet.hpp"
@@ -21,10 +22,13 @@ namespace tracer {
 
 enum class BvhSplit { Median, Sah };
 enum class BuildMode { Seq, Async, Queue, Tasks };
+inline constexpr EnumName<BvhSplit> kBvhSplitNames[] = {{BvhSplit::Sah, "sah"}, {BvhSplit::Median, "median"}};
+inline constexpr EnumName<BuildMode> kBuildModeNames[] = {
+    {BuildMode::Seq, "seq"}, {BuildMode::Async, "async"}, {BuildMode::Queue, "queue"}, {BuildMode::Tasks, "tasks"}};
 
 struct BvhBuildOptions {
   BvhSplit split = BvhSplit::Sah;
-  BuildMode mode = BuildMode::Seq;
+  BuildMode mode = BuildMode::Tasks;
   int threads = 0;   // 0: all hardware threads (parallel modes only)
   int max_leaf = 4;  // SAH: largest leaf; the median split always makes leaves of 1-2
   int bins = 16;     // SAH bins per axis
@@ -119,13 +123,12 @@ class Bvh {
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }  // scene index per slot
   const BvhBuildOptions& options() const { return options_; }
   const Scene& scene() const { return *scene_; }
-  static constexpr uint32_t kNoLeaf = 0xffffffffu;
   const std::vector<uint32_t>& pair_parents() const {
     return pair_parent_;
   }  // parent of pair nodes[2k], nodes[2k+1], at k
   const std::vector<uint32_t>& leaf_of() const {
     return leaf_of_;
-  }  // leaf of each scene triangle (kNoLeaf: degenerate)
+  }  // leaf of each scene triangle (kInvalidIndex: degenerate)
   BvhStats stats() const;
   size_t memory_bytes() const {
     return nodes_.size() * sizeof(BvhNode) + tris_.size() * sizeof(Triangle) +
@@ -147,7 +150,7 @@ class Bvh {
   TriangleArray tris_;
   std::vector<uint32_t> ids_;
   std::vector<uint32_t> pair_parent_;  // parent of the sibling pair nodes_[2k], nodes_[2k+1], at k
-  std::vector<uint32_t> leaf_of_;      // leaf holding each scene triangle (kNoLeaf: degenerate)
+  std::vector<uint32_t> leaf_of_;      // leaf holding each scene triangle (kInvalidIndex: degenerate)
 };
 
 // Slab test with a per-ray reciprocal direction (Williams et al. 2005, as pbrt does it): a zero

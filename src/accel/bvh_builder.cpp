@@ -26,12 +26,11 @@
 #include <immintrin.h>  // SSE2, part of every x86-64
 
 #include "accel/bvh.hpp"
-#include "sched/thread_count.hpp"
+#include "parallel/thread_count.hpp"
 
 namespace tracer {
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 constexpr uint32_t kParallelSubtree = 4096;    // below this a subtree is built by one thread
 constexpr uint32_t kParallelSplit = 65536;     // above this one node's passes run in parallel (tasks)
 constexpr uint32_t kPartitionBlock = 16384;    // block size of the parallel stable partition
@@ -41,7 +40,7 @@ constexpr int kMaxBins = 32;
 struct BuildNode {
   Aabb box;
   uint32_t begin = 0, end = 0;
-  uint32_t left = kNone;  // children at left and left+1, or kNone for a leaf
+  uint32_t left = kInvalidIndex;  // children at left and left+1, or kInvalidIndex for a leaf
   uint32_t depth = 0;
   uint32_t subtree = 0;       // nodes in this subtree, itself included; 0 until its build ends
   Aabb cbox;                  // bounds of the centroids
@@ -149,7 +148,7 @@ class BvhBuilder {
 
   void build() {
     if (count_ == 0) return;
-    nodes_[0] = BuildNode{{}, 0, count_, kNone, 0};
+    nodes_[0] = BuildNode{{}, 0, count_, kInvalidIndex, 0};
     node_count_ = 1;
     const int threads = resolve_thread_count(options_.threads);
     switch (options_.mode) {
@@ -305,12 +304,12 @@ class BvhBuilder {
   // Ends a node's build: records its subtree's size once its children's are known.
   void finish(uint32_t id) {
     BuildNode& n = nodes_[id];
-    n.subtree = n.left == kNone ? 1 : 1 + nodes_[n.left].subtree + nodes_[n.left + 1].subtree;
+    n.subtree = n.left == kInvalidIndex ? 1 : 1 + nodes_[n.left].subtree + nodes_[n.left + 1].subtree;
   }
 
   uint32_t subtree_size(uint32_t id) {
     BuildNode& n = nodes_[id];
-    if (n.subtree == 0) n.subtree = n.left == kNone ? 1 : 1 + subtree_size(n.left) + subtree_size(n.left + 1);
+    if (n.subtree == 0) n.subtree = n.left == kInvalidIndex ? 1 : 1 + subtree_size(n.left) + subtree_size(n.left + 1);
     return n.subtree;
   }
 
@@ -327,7 +326,7 @@ class BvhBuilder {
     BvhNode& f = out.nodes[flat];
     f.lo = n.box.lo;
     f.hi = n.box.hi;
-    if (n.left == kNone) {
+    if (n.left == kInvalidIndex) {
       f.index = n.begin;
       f.count = n.end - n.begin;
       const PrimRef* refs = buffers_[n.buffer].get();
@@ -435,8 +434,8 @@ class BvhBuilder {
     }
     const uint32_t left =
         cursor ? std::exchange(*cursor, *cursor + 2) : node_count_.fetch_add(2, std::memory_order_relaxed);
-    nodes_[left] = BuildNode{{}, begin, mid, kNone, node.depth + 1};
-    nodes_[left + 1] = BuildNode{{}, mid, end, kNone, node.depth + 1};
+    nodes_[left] = BuildNode{{}, begin, mid, kInvalidIndex, node.depth + 1};
+    nodes_[left + 1] = BuildNode{{}, mid, end, kInvalidIndex, node.depth + 1};
     if (children_known) {
       for (int c = 0; c < 2; ++c) {
         nodes_[left + c].box = child_box[c];
@@ -716,7 +715,7 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
   const auto construct = [&] {
     BvhBuilder builder(scene, options);
     builder.build();
-    leaf_of_.assign(scene.size(), kNoLeaf);
+    leaf_of_.assign(scene.size(), kInvalidIndex);
     builder.flatten(nodes_, ids_, pair_parent_, leaf_of_);
     tris_.resize(ids_.size());
     const auto copy = [&](size_t b, size_t e) {

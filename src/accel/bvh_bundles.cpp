@@ -116,7 +116,7 @@ uint32_t OccludedBundleFrom(const Bvh& bvh, const RayBundle& rays, uint32_t orig
   uint32_t active = TestBox(nodes[0], st, rays.active);
   if (active == 0) return 0;
   const auto& leaf_of = bvh.leaf_of();
-  if (origin >= leaf_of.size() || leaf_of[origin] == Bvh::kNoLeaf) return OccludedBelow(bvh, rays, 0, st, active);
+  if (origin >= leaf_of.size() || leaf_of[origin] == kInvalidIndex) return OccludedBelow(bvh, rays, 0, st, active);
   // The leaf, then each level's sibling subtree on the way up: together they cover the tree.
   uint32_t node = leaf_of[origin];
   uint32_t occluded = OccludedBelow(bvh, rays, node, st, active);

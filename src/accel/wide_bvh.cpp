@@ -129,7 +129,7 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
       const uint32_t slot = p.slot[i + size_t(k)];
       TriangleHit th;
       h &= ~(1u << k);
-      if (slot != 0xffffffffu && intersect_triangle(s, tris[slot], tnear, tfar, th)) {
+      if (slot != kInvalidIndex && intersect_triangle(s, tris[slot], tnear, tfar, th)) {
         h |= 1u << k;
         t_out[i + size_t(k)] = th.t;
         u_out[i + size_t(k)] = th.u;
@@ -334,7 +334,7 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
   const auto& nodes = bvh.nodes();
   if (nodes.empty() || rays.active == 0) return 0;
   const auto& leaves = bvh.leaf_places();
-  if (origin >= leaves.size() || leaves[origin] == WideBvh::kNoPlace) {
+  if (origin >= leaves.size() || leaves[origin] == kInvalidIndex) {
     uint32_t occluded = 0;  // no leaf to start from: each ray from the root
     for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
       const int k = __builtin_ctz(bits);
@@ -399,7 +399,7 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
     push_children(nodes[node], slot, active);
     search();
     where = bvh.node_places()[node];
-    if (where == WideBvh::kNoPlace) break;
+    if (where == kInvalidIndex) break;
     node = where / kWideWidth;
     slot = where % kWideWidth;
   }
@@ -469,7 +469,7 @@ TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t fi
     for (int vtx = 0; vtx < 3; ++vtx) {
       for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
     }
-    p.slot[lane] = used ? first + uint32_t(lane) : 0xffffffffu;
+    p.slot[lane] = used ? first + uint32_t(lane) : kInvalidIndex;
   }
   return p;
 }
@@ -484,17 +484,29 @@ uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t origin) c
 
 std::string WideBvh::simd_target() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CurrentTarget)()); }
 
-bool WideBvh::force_simd_target(const std::string& name) {
-  if (name == "auto" || name == "avx512") {
-    hwy::DisableTargets(0);
-  } else if (name == "avx2") {
-    hwy::DisableTargets(HWY_AVX3 | HWY_AVX3_DL);
-  } else if (name == "sse4") {
-    hwy::DisableTargets(HWY_AVX2 | HWY_AVX3 | HWY_AVX3_DL);
-  } else {
-    return false;
+void WideBvh::force_simd_target(SimdTarget target) {
+  switch (target) {
+    case SimdTarget::Auto:
+    case SimdTarget::Avx512:
+      hwy::DisableTargets(0);
+      break;
+    case SimdTarget::Avx2:
+      hwy::DisableTargets(HWY_AVX3 | HWY_AVX3_DL);
+      break;
+    case SimdTarget::Sse4:
+      hwy::DisableTargets(HWY_AVX2 | HWY_AVX3 | HWY_AVX3_DL);
+      break;
   }
-  return true;
+}
+
+bool WideBvh::force_simd_target(const std::string& name) {
+  for (const EnumName<SimdTarget>& e : kSimdTargetNames) {
+    if (e.name == name) {
+      force_simd_target(e.value);
+      return true;
+    }
+  }
+  return false;
 }
 
 namespace {
@@ -599,8 +611,8 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_
   Collapser(binary, nodes_, packs_).collapse(0);
   bounds_ = Aabb{binary.nodes()[0].lo, binary.nodes()[0].hi};
   // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
-  node_place_.assign(nodes_.size(), kNoPlace);
-  leaf_place_.assign(scene.size(), kNoPlace);
+  node_place_.assign(nodes_.size(), kInvalidIndex);
+  leaf_place_.assign(scene.size(), kInvalidIndex);
   for (uint32_t w = 0; w < nodes_.size(); ++w) {
     const WideNode& n = nodes_[w];
     for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
@@ -643,7 +655,7 @@ std::string WideBvh::validate() const {
         const TrianglePack& pk = packs_[n.child[i]];
         for (uint32_t lane = 0; lane < uint32_t(kWideWidth); ++lane) {
           if (lane >= n.count[i]) {
-            if (pk.slot[lane] != 0xffffffffu || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
+            if (pk.slot[lane] != kInvalidIndex || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
             continue;
           }
           const uint32_t k = pk.slot[lane];
@@ -672,9 +684,9 @@ std::string WideBvh::validate() const {
   for (size_t i = 0; i < visits.size(); ++i) {
     if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
   }
-  if (node_place_.empty() || node_place_[0] != kNoPlace) return "the root has a parent";
+  if (node_place_.empty() || node_place_[0] != kInvalidIndex) return "the root has a parent";
   for (size_t i = 0; i < seen.size(); ++i) {
-    if (seen[i] == 0 && leaf_place_[i] != kNoPlace)
+    if (seen[i] == 0 && leaf_place_[i] != kInvalidIndex)
       return "degenerate triangle " + std::to_string(i) + " has a leaf place";
   }
   return "";

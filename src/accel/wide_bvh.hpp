@@ -15,6 +15,11 @@
 
 namespace tracer {
 
+// The widest SIMD target the kernels may use; Auto is the CPU's best.
+enum class SimdTarget { Auto, Avx512, Avx2, Sse4 };
+inline constexpr EnumName<SimdTarget> kSimdTargetNames[] = {
+    {SimdTarget::Auto, "auto"}, {SimdTarget::Avx512, "avx512"}, {SimdTarget::Avx2, "avx2"}, {SimdTarget::Sse4, "sse4"}};
+
 inline constexpr int kWideWidth = 8;
 
 struct alignas(64) WideNode {
@@ -30,7 +35,7 @@ static_assert(sizeof(WideNode) == 256);
 // Unused lanes hold NaN vertices, which fail every comparison and so never hit.
 struct alignas(64) TrianglePack {
   float v[3][3][kWideWidth];  // [vertex][axis][lane]
-  uint32_t slot[kWideWidth];  // index into triangles()/triangle_ids(), or UINT32_MAX for padding
+  uint32_t slot[kWideWidth];  // index into triangles()/triangle_ids(), or kInvalidIndex for padding
 };
 
 class WideBvh {
@@ -54,11 +59,10 @@ class WideBvh {
   const std::vector<TrianglePack>& packs() const { return packs_; }
   const TriangleArray& triangles() const { return tris_; }
   const std::vector<uint32_t>& triangle_ids() const { return ids_; }
-  // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kNoPlace.
+  // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kInvalidIndex.
   const std::vector<uint32_t>& node_places() const { return node_place_; }
-  // The node and slot of the leaf holding each scene triangle (kNoPlace: degenerate, in no leaf).
+  // The node and slot of the leaf holding each scene triangle (kInvalidIndex: degenerate, in no leaf).
   const std::vector<uint32_t>& leaf_places() const { return leaf_place_; }
-  static constexpr uint32_t kNoPlace = 0xffffffffu;
   static constexpr uint32_t place(uint32_t node, uint32_t slot) { return node * kWideWidth + slot; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const {
@@ -74,6 +78,8 @@ class WideBvh {
   // Restricts the kernels to targets no wider than `name` ("sse4", "avx2", "avx512"); for
   // testing every target and for `--simd-target`. Returns false for an unknown name.
   static bool force_simd_target(const std::string& name);
+  // Process-wide: every later dispatch of the SIMD kernels uses at most `target`.
+  static void force_simd_target(SimdTarget target);
 
  private:
   const Scene* scene_;

@@ -200,7 +200,7 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
     st.tnear[lane] = r.tnear;
     st.t[lane] = r.tfar;
     st.u[lane] = st.v[lane] = 0.0f;
-    st.tri[lane] = int32_t(kInvalidId ^ uint32_t(kFlip));
+    st.tri[lane] = int32_t(kInvalidIndex ^ uint32_t(kFlip));
   }
   if (!shared_axes) {
     for (uint32_t bits = active; bits; bits &= bits - 1) {

@@ -23,11 +23,11 @@
 #include "base/errors.hpp"
 #include "cli/parse.hpp"
 #include "io/image_io.hpp"
+#include "render/render_image.hpp"
 #include "render/shading.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
-#include "sched/scheduler.hpp"
 
 namespace tracer::cli {
 namespace {

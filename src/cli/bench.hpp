@@ -5,8 +5,10 @@
 #include <CLI/CLI.hpp>
 
 #include <optional>
+
 #include <string>
 #include <vector>
+#include "render/shading.hpp"
 
 namespace tracer::cli {
 
@@ -14,7 +16,7 @@ struct BenchArgs {
   std::string variants = "study";  // comma list of names, or "study", "ours", "all"
   std::string scenes = "cornell";  // comma list of paths/names, or "cornell", "large", "all"
   std::string size = "256x256";
-  int ao = 16;
+  int ao = RenderSettings{}.ao_samples;
   int runs = 10, best = 3;
   std::optional<int> threads;  // empty: all hardware threads
   double max_seconds = 60.0;

@@ -36,8 +36,8 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
           {"ao_samples", settings.ao_samples},
           {"accel", accel.name},
           {"packets", settings.packets},
-          {"sched", to_string(sched.kind)},
-          {"threads", sched.kind == SchedKind::Seq ? 1 : resolve_thread_count(sched.threads)},
+          {"sched", name_of<SchedKind>(kSchedKindNames, sched.kind)},
+          {"threads", thread_count(sched)},
           {"load_ms", load_ms},
           {"build_ms", accel.build_ms},
           {"render_ms", render_ms},
@@ -79,6 +79,7 @@ int cmd_render(const RenderArgs& args) {
   const CancelFlag cancel = &stop_requested();
   validate(args);
   check_outputs(args);
+  WideBvh::force_simd_target(simd_target_for(args));
   const ThreadLimit thread_limit(args.threads.value_or(0));
   if (args.threads && ThreadLimit::oversubscribed(*args.threads)) {
     std::cerr << "tracer: warning: --threads " << *args.threads << " is more than this machine's hardware threads; all "
@@ -164,7 +165,7 @@ int main(int argc, char** argv) {
   render->add_option("-o,--output", render_args.output, "output image, .png or .ppm")->capture_default_str();
   render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
   render->add_option("--stats-json", render_args.stats_json, "write the statistics as JSON to this file");
-  render->add_flag("-q,--quiet", render_args.quiet, "no progress bar");
+  render->add_flag("-q,--quiet", render_args.quiet, "no progress bar, no loader warnings");
   render->add_flag("--save-partial", render_args.save_partial,
                    "on Ctrl-C, write the image with unfinished tiles black");
 

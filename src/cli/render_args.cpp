@@ -26,63 +26,60 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
 
 void add_render_options(CLI::App& app, RenderArgs& a) {
   add_scene_options(app, a.scene);
-  app.add_option("--width", a.width, "image width in pixels (1-16384)")->capture_default_str();
-  app.add_option("--height", a.height, "image height in pixels (1-16384)")->capture_default_str();
+  RenderSettings& s = a.settings;
+  app.add_option("--width", s.width, "image width in pixels (1-16384)")->capture_default_str();
+  app.add_option("--height", s.height, "image height in pixels (1-16384)")->capture_default_str();
   app.add_option("--eye,-v", a.eye, "camera position x,y,z (default: frame the scene from the front)");
   app.add_option("--look,-l", a.look, "point the camera looks at, x,y,z");
   app.add_option("--up", a.up, "camera up vector x,y,z (default 0,1,0)");
   app.add_option("--fov", a.fov, "vertical field of view in degrees (default 53.13)");
-  app.add_option("--ao", a.ao, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
+  app.add_option("--ao", s.ao_samples, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
   app.add_option("--ao-distance", a.ao_distance, "maximum distance of AO rays (default: unbounded)");
-  app.add_option("--ambient", a.ambient, "ambient light strength")->capture_default_str();
-  app.add_option("--exposure", a.exposure, "tone-mapping exposure")->capture_default_str();
-  app.add_option("--seed", a.seed, "seed of the AO sample pattern")->capture_default_str();
-  app.add_option("--accel", a.accel, "accelerator: brute, bvh, bvh8 (8-wide SIMD), embree")->capture_default_str();
-  app.add_option("--bvh-split", a.split, "BVH split: sah or median (the study's)")->capture_default_str();
-  app.add_option("--build", a.build, "BVH build: seq, async, queue, tasks")->capture_default_str();
-  app.add_option("--max-leaf", a.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
-  app.add_option("--bins", a.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
-  app.add_option("--traversal-cost", a.traversal_cost,
+  app.add_option("--ambient", s.ambient, "ambient light strength")->capture_default_str();
+  app.add_option("--exposure", s.exposure, "tone-mapping exposure")->capture_default_str();
+  app.add_option("--seed", s.seed, "seed of the AO sample pattern")->capture_default_str();
+  app.add_option("--accel", a.accel, "accelerator: " + names_of<AccelKind>(kAccelKindNames))->capture_default_str();
+  app.add_option("--bvh-split", a.split, "BVH split: " + names_of<BvhSplit>(kBvhSplitNames) + " (the study's)")
+      ->capture_default_str();
+  app.add_option("--build", a.build, "BVH build: " + names_of<BuildMode>(kBuildModeNames))->capture_default_str();
+  app.add_option("--max-leaf", a.bvh.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
+  app.add_option("--bins", a.bvh.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
+  app.add_option("--traversal-cost", a.bvh.traversal_cost,
                  "SAH BVH: cost of a node step relative to a triangle test (0-100)")
       ->capture_default_str();
   app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")
       ->capture_default_str();
-  app.add_option("--simd-target", a.simd_target, "bvh8 kernels: auto, or force a narrower target: avx2, sse4")
+  app.add_option(
+         "--simd-target", a.simd_target,
+         "bvh8 kernels: " + names_of<SimdTarget>(kSimdTargetNames) + " (force a narrower target than the CPU's)")
       ->capture_default_str();
-  app.add_flag("--packets", a.packets,
+  app.add_flag("--packets", s.packets,
                "trace rays together: each hit's AO rays as one bundle (bvh, bvh8), primary rays in 4x4-pixel packets "
                "(bvh8); same image");
-  app.add_option("--sched", a.sched, "scheduler: seq, async, queue, atomic, tbb")->capture_default_str();
+  app.add_option("--sched", a.sched_kind, "scheduler: " + names_of<SchedKind>(kSchedKindNames))->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
-  app.add_option("--tile", a.tile, "tile edge in pixels for the atomic and tbb schedulers")->capture_default_str();
-  app.add_option("--block", a.block, "pixels per row block for the queue scheduler")->capture_default_str();
+  app.add_option("--tile", a.sched.tile, "tile edge in pixels for the atomic and tbb schedulers")
+      ->capture_default_str();
+  app.add_option("--block", a.sched.block, "pixels per row block for the queue scheduler")->capture_default_str();
 }
-
-namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-}  // namespace
 
 void validate(const RenderArgs& a) {
-  check_range("--width", a.width, 1, 16384);
-  check_range("--height", a.height, 1, 16384);
-  check_range("--ao", a.ao, 0, 4096);
+  const RenderSettings& s = a.settings;
+  check_range("--width", s.width, 1, 16384);
+  check_range("--height", s.height, 1, 16384);
+  check_range("--ao", s.ao_samples, 0, 4096);
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
   if (a.fov) check_range_real("--fov", *a.fov, 0.0, 179.0, true);
-  check_range_real("--ambient", a.ambient, 0.0, 1e6);
-  check_range_real("--exposure", a.exposure, 0.0, 1e6, true);
+  check_range_real("--ambient", s.ambient, 0.0, 1e6);
+  check_range_real("--exposure", s.exposure, 0.0, 1e6, true);
   check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);
   if (a.scene.light_intensity) check_range_real("--light-intensity", *a.scene.light_intensity, 0.0, 1e30);
   if (a.threads) check_range("--threads", *a.threads, 1, 1024);
-  check_range("--tile", a.tile, 1, 4096);
-  check_range("--block", a.block, 1, 1 << 20);
-  check_range("--max-leaf", a.max_leaf, 1, 16);
-  check_range("--bins", a.bins, 4, 32);
-  check_range_real("--traversal-cost", a.traversal_cost, 0.0, 100.0, true);
+  check_range("--tile", a.sched.tile, 1, 4096);
+  check_range("--block", a.sched.block, 1, 1 << 20);
+  check_range("--max-leaf", a.bvh.max_leaf, 1, 16);
+  check_range("--bins", a.bvh.bins, 4, 32);
+  check_range_real("--traversal-cost", a.bvh.traversal_cost, 0.0, 100.0, true);
   if (!a.eye.empty()) parse_point("--eye", a.eye);
   if (!a.look.empty()) parse_point("--look", a.look);
   if (!a.up.empty()) {
@@ -90,13 +87,11 @@ void validate(const RenderArgs& a) {
   }
   for (const auto& l : a.scene.lights) parse_point("--light", l);
   const AccelOptions accel = accel_options_for(a);
-  if (a.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh) {
+  if (s.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh) {
     throw UsageError("--packets: needs --accel bvh or bvh8 (the accelerators with packet kernels)");
   }
-  parse_sched(a.sched);
-  if (!WideBvh::force_simd_target(lower(a.simd_target))) {
-    throw UsageError("--simd-target: unknown target '" + a.simd_target + "' (auto, avx512, avx2, sse4)");
-  }
+  sched_options_for(a);
+  simd_target_for(a);
 }
 
 // Two paths name the same file: the same inode if both exist, else the same absolute path.
@@ -162,67 +157,36 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
 }
 
 RenderSettings settings_for(const RenderArgs& a) {
-  RenderSettings s;
-  s.width = a.width;
-  s.height = a.height;
-  s.ao_samples = a.ao;
-  s.ao_distance = a.ao_distance ? float(*a.ao_distance) : kInfinity;
-  s.ambient = float(a.ambient);
-  s.exposure = float(a.exposure);
-  s.seed = a.seed;
-  s.packets = a.packets;
+  RenderSettings s = a.settings;
+  if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
   return s;
 }
 
 AccelOptions accel_options_for(const RenderArgs& a) {
   AccelOptions o;
-  const std::string accel = lower(a.accel);
-  const std::string simd = lower(a.simd);
+  o.bvh = a.bvh;
+  const std::string simd = a.simd;
   if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
-  if (accel == "brute")
-    o.kind = simd == "auto" ? AccelKind::BruteSimd : AccelKind::Brute;
-  else if (accel == "bvh")
-    o.kind = AccelKind::Bvh;
-  else if (accel == "bvh8" && simd == "off")
+  o.kind = parse_name<AccelKind>(kAccelKindNames, a.accel, "--accel", "accelerator");
+  if (o.kind == AccelKind::BruteSimd && simd == "off") o.kind = AccelKind::Brute;
+  if (o.kind == AccelKind::Bvh8 && simd == "off") {
     throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
-  else if (accel == "bvh8")
-    o.kind = AccelKind::Bvh8;
-  else if (accel == "embree")
-    o.kind = AccelKind::Embree;
-  else
-    throw UsageError("--accel: unknown accelerator '" + a.accel + "' (brute, bvh, bvh8, embree)");
-  const std::string split = lower(a.split);
-  if (split == "sah")
-    o.bvh.split = BvhSplit::Sah;
-  else if (split == "median")
-    o.bvh.split = BvhSplit::Median;
-  else
-    throw UsageError("--bvh-split: unknown split '" + a.split + "' (sah, median)");
-  const std::string build = lower(a.build);
-  if (build == "seq")
-    o.bvh.mode = BuildMode::Seq;
-  else if (build == "async")
-    o.bvh.mode = BuildMode::Async;
-  else if (build == "queue")
-    o.bvh.mode = BuildMode::Queue;
-  else if (build == "tasks")
-    o.bvh.mode = BuildMode::Tasks;
-  else
-    throw UsageError("--build: unknown builder '" + a.build + "' (seq, async, queue, tasks)");
+  }
+  o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
+  o.bvh.mode = parse_name<BuildMode>(kBuildModeNames, a.build, "--build", "builder");
   o.bvh.threads = a.threads.value_or(0);
-  o.bvh.max_leaf = a.max_leaf;
-  o.bvh.bins = a.bins;
-  o.bvh.traversal_cost = float(a.traversal_cost);
   return o;
 }
 
 SchedOptions sched_options_for(const RenderArgs& a) {
-  SchedOptions o;
-  o.kind = parse_sched(lower(a.sched));
+  SchedOptions o = a.sched;
+  o.kind = parse_name<SchedKind>(kSchedKindNames, a.sched_kind, "--sched", "scheduler");
   o.threads = a.threads.value_or(0);
-  o.tile = a.tile;
-  o.block = a.block;
   return o;
+}
+
+SimdTarget simd_target_for(const RenderArgs& a) {
+  return parse_name<SimdTarget>(kSimdTargetNames, a.simd_target, "--simd-target", "target");
 }
 
 }  // namespace tracer::cli

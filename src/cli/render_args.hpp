@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "render/render_image.hpp"
 #include "render/shading.hpp"
 #include "scene/scene.hpp"
-#include "sched/scheduler.hpp"
 
 namespace tracer::cli {
 
@@ -23,24 +23,23 @@ struct SceneArgs {
   std::optional<double> light_intensity;
 };
 
+// The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,
+// SchedOptions): the flags bind to those structs, and named values start from their tables.
 struct RenderArgs {
   SceneArgs scene;
-  int width = 1024, height = 1024;
+  RenderSettings settings;  // --width --height --ao --ambient --exposure --seed --packets
+  BvhBuildOptions bvh;      // --max-leaf --bins --traversal-cost
+  SchedOptions sched;       // --tile --block
   std::string eye, look, up;
   std::optional<double> fov;
-  int ao = 16;
   std::optional<double> ao_distance;
-  double ambient = 0.25, exposure = 1.5;
-  unsigned seed = 0;
-  std::string accel = "bvh", split = "sah", build = "tasks";
-  int max_leaf = 4, bins = 16;
-  double traversal_cost = 1.5;  // SAH: a node step relative to a triangle test
+  std::string accel{name_of<AccelKind>(kAccelKindNames, AccelOptions{}.kind)};
+  std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
+  std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
+  std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};
   std::string simd = "auto";
-  std::string simd_target = "auto";
-  bool packets = false;
-  std::string sched = "tbb";
+  std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
   std::optional<int> threads;
-  int tile = 16, block = 64;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;
   std::string stats_json;
@@ -58,6 +57,8 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 RenderSettings settings_for(const RenderArgs& args);
 AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
-void validate(const RenderArgs& args);  // throws UsageError naming the flag
+SimdTarget simd_target_for(const RenderArgs& args);
+// Checks every flag; throws UsageError naming the flag. Changes nothing.
+void validate(const RenderArgs& args);
 
 }  // namespace tracer::cli

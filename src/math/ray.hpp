@@ -4,12 +4,12 @@
 #include <cstdint>
 #include <limits>
 
+#include "base/invalid_index.hpp"
 #include "math/vec.hpp"
 
 namespace tracer {
 
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
-inline constexpr uint32_t kInvalidId = 0xffffffffu;
 
 struct Ray {
   Vec3 org;
@@ -24,11 +24,11 @@ struct Ray {
 struct Hit {
   float t = kInfinity;
   float u = 0.0f, v = 0.0f;
-  uint32_t geomID = kInvalidId;
-  uint32_t primID = kInvalidId;
-  uint32_t tri = kInvalidId;
+  uint32_t geomID = kInvalidIndex;
+  uint32_t primID = kInvalidIndex;
+  uint32_t tri = kInvalidIndex;
 
-  bool valid() const { return tri != kInvalidId; }
+  bool valid() const { return tri != kInvalidIndex; }
 };
 
 }  // namespace tracer

@@ -5,16 +5,6 @@
 
 namespace tracer {
 
-std::vector<Tile> make_tiles(int width, int height, int tile_w, int tile_h) {
-  std::vector<Tile> tiles;
-  for (int y = 0; y < height; y += tile_h) {
-    for (int x = 0; x < width; x += tile_w) {
-      tiles.push_back({x, y, std::min(x + tile_w, width), std::min(y + tile_h, height)});
-    }
-  }
-  return tiles;
-}
-
 namespace {
 
 uint8_t encode(float linear, float exposure) {

@@ -13,6 +13,7 @@
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
 #include "math/rng.hpp"
+#include "parallel/tiles.hpp"
 #include "render/framebuffer.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene.hpp"

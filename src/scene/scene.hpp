@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "base/invalid_index.hpp"
 #include "math/aabb.hpp"
 #include "math/vec.hpp"
 
@@ -46,8 +47,8 @@ struct Light {
   Vec3 position;
   Vec3 normal;
   Vec3 power;
-  float area = 0.0f;             // emitting area (0 for point lights)
-  uint32_t geomID = UINT32_MAX;  // the emitting geometry, or UINT32_MAX for point lights
+  float area = 0.0f;                // emitting area (0 for point lights)
+  uint32_t geomID = kInvalidIndex;  // the emitting geometry, or kInvalidIndex for point lights
   bool is_point() const { return normal == Vec3{0.0f}; }
 };
 

@@ -1,0 +1,51 @@
+// Parallel loops over the tiles of an image, in the five ways the study compares: the strategy
+// alone, knowing nothing of rays or colours (pbrt-v4's ParallelFor2D is the model). The render
+// loop, the tests and any distributed driver hand their per-tile work to parallel_for_tiles().
+#pragma once
+
+#include <functional>
+
+#include "base/enum_names.hpp"
+#include "base/errors.hpp"
+#include "parallel/thread_count.hpp"
+#include "parallel/tiles.hpp"
+
+namespace tracer {
+
+enum class SchedKind {
+  Seq,     // one thread, row by row
+  Async,   // the study's: one std::async(std::launch::async) per image row
+  Queue,   // the study's: N threads popping row blocks from a mutex-guarded LIFO vector
+  Atomic,  // lock-free: N threads claiming square tiles with one fetch_add each
+  Tbb,     // oneTBB parallel_for over square tiles, work stealing (the default)
+};
+
+inline constexpr EnumName<SchedKind> kSchedKindNames[] = {{SchedKind::Seq, "seq"},
+                                                          {SchedKind::Async, "async"},
+                                                          {SchedKind::Queue, "queue"},
+                                                          {SchedKind::Atomic, "atomic"},
+                                                          {SchedKind::Tbb, "tbb"}};
+
+struct SchedOptions {
+  SchedKind kind = SchedKind::Tbb;
+  int threads = 0;  // 0: every hardware thread the process may use
+  int tile = 16;    // square tile edge for atomic and tbb
+  int block = 64;   // pixels per row block for queue
+};
+
+// The tiles `options.kind` hands out for a width x height image: rows (seq, async), row blocks of
+// `block` pixels (queue) or `tile`-edged squares (atomic, tbb). The one place tiles are made.
+std::vector<Tile> tiles_for(int width, int height, const SchedOptions& options);
+
+// Calls fn(tile) once for every tile of tiles_for(width, height, options), concurrently as the
+// strategy decides; once `cancel` is set no further tile starts. Returns false if cancelled. fn
+// must be safe to call concurrently for different tiles.
+bool parallel_for_tiles(int width, int height, const SchedOptions& options, CancelFlag cancel,
+                        const std::function<void(const Tile&)>& fn);
+
+// How many threads `options` runs (1 for seq).
+inline int thread_count(const SchedOptions& options) {
+  return options.kind == SchedKind::Seq ? 1 : resolve_thread_count(options.threads);
+}
+
+}  // namespace tracer
