@@ -1,0 +1,67 @@
+// SIMD brute force (the study's ISPC column): every ray against every triangle, eight triangles
+// per test with the 8-wide BVH's pack kernel, compiled once per SIMD target.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/simd_brute_force.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "accel/brute_force.hpp"
+#include "accel/wide_bvh.hpp"
+#include "accel/wide_bvh_kernels-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Brute force over packs: closest hit, ties to the lower scene index as everywhere.
+bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
+  hit = Hit{};
+  hit.t = ray.tfar;
+  const RayShear shear(ray);
+  const Triangle* tris = bf.triangles().data();
+  const uint32_t* ids = bf.triangle_ids().data();
+  for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ids, ray.tnear, hit);
+  return finish_hit(bf.scene(), hit);
+}
+
+bool OccludedBrute(const SimdBruteForce& bf, const Ray& ray) {
+  const RayShear shear(ray);
+  const Triangle* tris = bf.triangles().data();
+  HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  for (const TrianglePack& p : bf.packs()) {
+    if (IntersectPack(p, shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) return true;
+  }
+  return false;
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer {
+
+HWY_EXPORT(IntersectBrute);
+HWY_EXPORT(OccludedBrute);
+
+bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const {
+  return HWY_DYNAMIC_DISPATCH(IntersectBrute)(*this, ray, hit);
+}
+bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
+
+SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
+  for (uint32_t i = 0; i < scene.size(); ++i) {
+    if (scene.triangles[i].degenerate()) continue;
+    tris_.push_back(scene.triangles[i]);
+    ids_.push_back(i);
+  }
+  for (uint32_t first = 0; first < tris_.size(); first += kWideWidth) {
+    packs_.push_back(make_triangle_pack(tris_, first, std::min<uint32_t>(kWideWidth, uint32_t(tris_.size()) - first)));
+  }
+}
+
+}  // namespace tracer
+#endif  // HWY_ONCE

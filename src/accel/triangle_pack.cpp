@@ -1,0 +1,23 @@
+// Packing triangles eight to a SIMD pack (SoA), for the 8-wide BVH's leaves and SIMD brute force.
+#include <limits>
+
+#include "accel/wide_bvh.hpp"
+
+namespace tracer {
+
+TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t first, uint32_t count) {
+  TrianglePack p;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int lane = 0; lane < kWideWidth; ++lane) {
+    const bool used = uint32_t(lane) < count;
+    const Triangle& t = triangles[used ? first + uint32_t(lane) : first];
+    const Vec3 vs[3] = {t.v0, t.v1, t.v2};
+    for (int vtx = 0; vtx < 3; ++vtx) {
+      for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
+    }
+    p.slot[lane] = used ? first + uint32_t(lane) : kInvalidIndex;
+  }
+  return p;
+}
+
+}  // namespace tracer

@@ -1,0 +1,127 @@
+// Building the 8-wide BVH: the binary SAH tree collapsed into 8-wide nodes, leaves packed, and
+// where every node and leaf hangs recorded for the bundles' walk up from a leaf.
+#include <algorithm>
+#include <vector>
+
+#include "accel/wide_bvh.hpp"
+
+namespace tracer {
+
+namespace {
+
+// Collapses the binary subtree under `root` into wide nodes, appending to `out`; returns the
+// index of the wide node made for `root`.
+class Collapser {
+ public:
+  Collapser(const Bvh& bin, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
+      : bin_(bin), out_(out), packs_(packs), first_(bin.nodes().size()), count_(bin.nodes().size()) {
+    // Each binary subtree's triangles are one contiguous run (the builder lays leaves out in
+    // depth-first order); record it, children before parents (children have larger indices).
+    const auto& nodes = bin.nodes();
+    for (size_t i = nodes.size(); i-- > 0;) {
+      if (i == 1) continue;  // padding
+      const BvhNode& n = nodes[i];
+      first_[i] = n.leaf() ? n.index : first_[n.index];
+      count_[i] = n.leaf() ? n.count : count_[n.index] + count_[n.index + 1];
+    }
+  }
+
+  uint32_t collapse(uint32_t root) {
+    // Open the largest inner node until eight children (or only leaves) remain: keeps the
+    // children's total surface area, and so the expected cost, as low as greedy can.
+    std::vector<uint32_t> kids{root};
+    if (!packable(root)) kids = {bin_.nodes()[root].index, bin_.nodes()[root].index + 1};
+    while (kids.size() < size_t(kWideWidth)) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (size_t i = 0; i < kids.size(); ++i) {
+        const BvhNode& n = bin_.nodes()[kids[i]];
+        const float area = Aabb{n.lo, n.hi}.half_area();
+        if (!packable(kids[i]) && area > best_area) {
+          best = int(i);
+          best_area = area;
+        }
+      }
+      if (best < 0) break;
+      const BvhNode& n = bin_.nodes()[kids[size_t(best)]];
+      kids[size_t(best)] = n.index;
+      kids.insert(kids.begin() + best + 1, n.index + 1);
+    }
+    const auto self = static_cast<uint32_t>(out_.size());
+    out_.emplace_back();
+    {
+      WideNode& w = out_[self];
+      for (int i = 0; i < kWideWidth; ++i) {
+        w.lo_x[i] = w.lo_y[i] = w.lo_z[i] = kInfinity;
+        w.hi_x[i] = w.hi_y[i] = w.hi_z[i] = -kInfinity;
+        w.child[i] = 0;
+        w.count[i] = 0;
+      }
+    }
+    for (size_t i = 0; i < kids.size(); ++i) {
+      const BvhNode& n = bin_.nodes()[kids[i]];
+      uint32_t child = 0, count = 0;
+      if (packable(kids[i])) {
+        count = count_[kids[i]];
+        child = make_pack(first_[kids[i]], count);
+      } else {
+        child = collapse(kids[i]);  // may reallocate out_: index, not reference
+      }
+      WideNode& w = out_[self];
+      w.lo_x[i] = n.lo.x;
+      w.lo_y[i] = n.lo.y;
+      w.lo_z[i] = n.lo.z;
+      w.hi_x[i] = n.hi.x;
+      w.hi_y[i] = n.hi.y;
+      w.hi_z[i] = n.hi.z;
+      w.child[i] = child;
+      w.count[i] = count;
+    }
+    return self;
+  }
+
+ private:
+  // A subtree of at most one pack's worth of triangles becomes one leaf: testing eight lanes
+  // costs about what one more level of boxes would, and saves that level's loads.
+  bool packable(uint32_t node) const { return count_[node] <= uint32_t(kWideWidth); }
+
+  uint32_t make_pack(uint32_t first, uint32_t count) {
+    packs_.push_back(make_triangle_pack(bin_.triangles(), first, count));
+    return static_cast<uint32_t>(packs_.size() - 1);
+  }
+
+  const Bvh& bin_;
+  std::vector<WideNode>& out_;
+  std::vector<TrianglePack>& packs_;
+  std::vector<uint32_t> first_, count_;  // per binary node: its subtree's triangle run
+};
+
+}  // namespace
+
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_(&scene) {
+  BvhBuildOptions options = options_in;
+  options.max_leaf = std::min(options.max_leaf, kWideWidth);
+  const Bvh binary(scene, options);
+  tris_ = binary.triangles();
+  ids_ = binary.triangle_ids();
+  if (binary.nodes().empty()) return;
+  nodes_.reserve(binary.nodes().size() / 4 + 1);
+  Collapser(binary, nodes_, packs_).collapse(0);
+  bounds_ = Aabb{binary.nodes()[0].lo, binary.nodes()[0].hi};
+  // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
+  node_place_.assign(nodes_.size(), kInvalidIndex);
+  leaf_place_.assign(scene.size(), kInvalidIndex);
+  for (uint32_t w = 0; w < nodes_.size(); ++w) {
+    const WideNode& n = nodes_[w];
+    for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
+      if (n.count[c] > 0) {
+        const TrianglePack& pack = packs_[n.child[c]];
+        for (uint32_t lane = 0; lane < n.count[c]; ++lane) leaf_place_[ids_[pack.slot[lane]]] = place(w, c);
+      } else if (n.child[c] != 0) {  // child 0 is the root: an empty slot
+        node_place_[n.child[c]] = place(w, c);
+      }
+    }
+  }
+}
+
+}  // namespace tracer

@@ -1,0 +1,62 @@
+// The 8-wide BVH's single-ray kernels, closest hit and any hit, compiled once per SIMD target.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/wide_bvh_traverse.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "accel/wide_bvh.hpp"
+#include "accel/wide_bvh_kernels-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
+  hit = Hit{};
+  hit.t = ray.tfar;
+  const auto& nodes = bvh.nodes();
+  if (nodes.empty()) return false;
+  const WideRay wr(ray);
+  const RayShear shear(ray);
+  const Triangle* tris = bvh.triangles().data();
+  const uint32_t* ids = bvh.triangle_ids().data();
+  const TrianglePack* packs = bvh.packs().data();
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  HWY_ALIGN float t[kWideWidth];
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode& n = nodes[cur.child];
+      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
+    } else {
+      ClosestInPack(packs[cur.child], shear, tris, ids, ray.tnear, hit);
+    }
+    // Pop, skipping entries now beyond the closest hit (<=: ties still count).
+    do {
+      if (sp == 0) return finish_hit(bvh.scene(), hit);
+      cur = stack[--sp];
+    } while (!(cur.t <= hit.t * RayBoxTest::kTieGuard));
+  }
+}
+
+bool OccludedWide(const WideBvh& bvh, const Ray& ray) { return OccludedFromRoot(bvh, ray); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer {
+
+HWY_EXPORT(IntersectWide);
+HWY_EXPORT(OccludedWide);
+
+// One table-indexed call per ray (Highway's dynamic dispatch), never per node: the kernels above
+// inline the whole traversal.
+bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectWide)(*this, ray, hit); }
+bool WideBvh::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedWide)(*this, ray); }
+
+}  // namespace tracer
+#endif  // HWY_ONCE

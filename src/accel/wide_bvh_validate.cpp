@@ -1,0 +1,77 @@
+// The 8-wide BVH's validator: every child box contains its subtree, every non-degenerate
+// triangle is in exactly one leaf, the recorded places agree with the tree.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "accel/wide_bvh.hpp"
+
+namespace tracer {
+
+std::string WideBvh::validate() const {
+  if (nodes_.empty()) return tris_.empty() ? "" : "triangles but no nodes";
+  std::vector<uint32_t> seen(scene_->size(), 0);
+  std::vector<uint32_t> visits(nodes_.size(), 0);
+  std::vector<uint32_t> stack{0};
+  // Every triangle below a child must lie in that child's box; check leaf by leaf.
+  struct Pending {
+    uint32_t node;
+    Aabb box;
+  };
+  std::vector<Pending> work{{0, bounds_}};  // the root's children lie in the tree's bounds
+  while (!work.empty()) {
+    const Pending p = work.back();
+    work.pop_back();
+    if (p.node >= nodes_.size()) return "node index out of range";
+    if (++visits[p.node] > 1) return "node " + std::to_string(p.node) + " reached twice";
+    const WideNode& n = nodes_[p.node];
+    for (int i = 0; i < kWideWidth; ++i) {
+      const Aabb box{{n.lo_x[i], n.lo_y[i], n.lo_z[i]}, {n.hi_x[i], n.hi_y[i], n.hi_z[i]}};
+      if (box.empty()) {
+        if (n.count[i] != 0 || n.child[i] != 0) return "empty slot with contents";
+        continue;
+      }
+      if (!p.box.contains(box)) return "child box outside its parent's box";
+      if (n.count[i] > 0) {
+        if (n.child[i] >= packs_.size() || n.count[i] > uint32_t(kWideWidth)) return "leaf pack out of range";
+        const TrianglePack& pk = packs_[n.child[i]];
+        for (uint32_t lane = 0; lane < uint32_t(kWideWidth); ++lane) {
+          if (lane >= n.count[i]) {
+            if (pk.slot[lane] != kInvalidIndex || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
+            continue;
+          }
+          const uint32_t k = pk.slot[lane];
+          if (k >= tris_.size()) return "pack slot out of range";
+          const Triangle& t = tris_[k];
+          if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
+          if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
+          if (leaf_place_.size() != seen.size() || leaf_place_[ids_[k]] != place(p.node, uint32_t(i))) {
+            return "leaf place of triangle " + std::to_string(ids_[k]) + " is wrong";
+          }
+          ++seen[ids_[k]];
+        }
+      } else {
+        if (n.child[i] >= node_place_.size() || node_place_[n.child[i]] != place(p.node, uint32_t(i))) {
+          return "node " + std::to_string(n.child[i]) + " does not record its parent";
+        }
+        work.push_back({n.child[i], box});
+      }
+    }
+  }
+  for (size_t i = 0; i < seen.size(); ++i) {
+    const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
+    if (seen[i] != expected)
+      return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
+  }
+  for (size_t i = 0; i < visits.size(); ++i) {
+    if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
+  }
+  if (node_place_.empty() || node_place_[0] != kInvalidIndex) return "the root has a parent";
+  for (size_t i = 0; i < seen.size(); ++i) {
+    if (seen[i] == 0 && leaf_place_[i] != kInvalidIndex)
+      return "degenerate triangle " + std::to_string(i) + " has a leaf place";
+  }
+  return "";
+}
+
+}  // namespace tracer
