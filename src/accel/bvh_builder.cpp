@@ -5,10 +5,6 @@
 // the partitions are stable, so all builders produce the same tree. Nodes are first written into
 // a scratch array in whatever order threads reach them, then flattened depth-first, which fixes
 // the final layout independently of scheduling.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -26,6 +22,7 @@
 #include <immintrin.h>  // SSE2, part of every x86-64
 
 #include "accel/bvh.hpp"
+#include "parallel/tbb_sync.hpp"
 #include "parallel/thread_count.hpp"
 
 namespace tracer {
@@ -126,23 +123,15 @@ class BvhBuilder {
     }
     const uint32_t blocks = (n + kPartitionBlock - 1) / kPartitionBlock;
     std::vector<uint32_t> offsets(blocks + 1, 0);
-    publish();
-    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
-      publish();
+    sync_.for_each(blocks, [&](uint32_t k) {
       uint32_t c = 0;
       for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i)
         c += scene.triangles[i].degenerate() ? 0 : 1;
       offsets[k + 1] = c;
-      publish();
     });
-    publish();
     for (uint32_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
-    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
-      publish();
-      fill(k * kPartitionBlock, std::min(n, (k + 1) * kPartitionBlock), offsets[k]);
-      publish();
-    });
-    publish();
+    sync_.for_each(blocks,
+                   [&](uint32_t k) { fill(k * kPartitionBlock, std::min(n, (k + 1) * kPartitionBlock), offsets[k]); });
     count_ = offsets[blocks];
   }
 
@@ -161,11 +150,9 @@ class BvhBuilder {
       case BuildMode::Queue:
         build_queue(threads);
         break;
-      case BuildMode::Tasks: {
+      case BuildMode::Tasks:
         build_tasks(0);  // inside the caller's task arena
-        publish();
         break;
-      }
     }
   }
 
@@ -181,10 +168,8 @@ class BvhBuilder {
     pair_parent.assign((out.size() + 1) / 2, 0);
     if (count_ == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
-    publish();
     const Output o{out.data(), ids.data(), pair_parent.data(), leaf_of.data()};
     place(o, 0, 0, 2, options_.mode == BuildMode::Tasks);
-    publish();
   }
 
  private:
@@ -277,29 +262,9 @@ class BvhBuilder {
     }
     if (!split(id, size >= kParallelSplit)) return finish(id);
     const uint32_t left = nodes_[id].left;
-    publish();  // the children's nodes and primitives, written above, to whichever thread takes them
-    tbb::parallel_invoke(
-        [&] {
-          publish();
-          build_tasks(left);
-          publish();
-        },
-        [&] {
-          publish();
-          build_tasks(left + 1);
-          publish();
-        });
-    publish();
+    sync_.fork_join([&] { build_tasks(left); }, [&] { build_tasks(left + 1); });
     finish(id);
   }
-
-  // TBB's own forks and joins happen inside a library ThreadSanitizer cannot see into. Every
-  // parallel piece starts and ends with an acq_rel increment of one shared counter, and every
-  // fork and join does one too, which gives the happens-before edges TBB already guarantees in a
-  // form TSan understands (without them TSan reports, and with TBB's frames suppressed still
-  // processes, every node and primitive handed between threads: minutes per build).
-  // A few atomics per task or data-parallel chunk, never per node or primitive.
-  void publish() const { sync_.fetch_add(1, std::memory_order_acq_rel); }
 
   // Ends a node's build: records its subtree's size once its children's are known.
   void finish(uint32_t id) {
@@ -343,17 +308,7 @@ class BvhBuilder {
     const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
     const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
     if (parallel && n.end - n.begin >= kParallelSubtree) {
-      tbb::parallel_invoke(
-          [&] {
-            publish();
-            place_left();
-            publish();
-          },
-          [&] {
-            publish();
-            place_right();
-            publish();
-          });
+      sync_.fork_join(place_left, place_right);
     } else {
       place_left();
       place_right();
@@ -363,22 +318,7 @@ class BvhBuilder {
   template <class Body, class T>
   T reduce_range(uint32_t begin, uint32_t end, bool parallel, T init, const Body& body) const {
     if (!parallel) return body(begin, end, init);
-    publish();
-    T result = tbb::parallel_reduce(
-        tbb::blocked_range<uint32_t>(begin, end, kPartitionBlock), init,
-        [&](const tbb::blocked_range<uint32_t>& r, T acc) {
-          sync_.fetch_add(1, std::memory_order_acq_rel);
-          T out = body(r.begin(), r.end(), acc);
-          sync_.fetch_add(1, std::memory_order_acq_rel);
-          return out;
-        },
-        [&](T a, const T& b) {
-          sync_.fetch_add(1, std::memory_order_acq_rel);
-          a.join(b);
-          return a;
-        });
-    publish();
-    return result;
+    return sync_.reduce(begin, end, kPartitionBlock, init, body);
   }
 
   // Decides node `id`: a leaf (false) or two children (true), placed at *cursor (which advances)
@@ -673,25 +613,18 @@ class BvhBuilder {
     }
     const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
     std::vector<uint32_t> left_counts(blocks + 1, 0);
-    publish();
-    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
-      publish();
+    sync_.for_each(blocks, [&](uint32_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       uint32_t c = 0;
       for (uint32_t i = b; i < e; ++i) c += pred(src[i]) ? 1 : 0;
       left_counts[k + 1] = c;
-      publish();
     });
-    publish();
     for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
     std::vector<SideCentroids> block(blocks);
-    tbb::parallel_for(0u, blocks, [&](uint32_t k) {
-      publish();
+    sync_.for_each(blocks, [&](uint32_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       run(b, e, begin + left_counts[k], mid + (b - begin) - left_counts[k], block[k]);  // rights before this block
-      publish();
     });
-    publish();
     for (uint32_t k = 0; k < blocks; ++k) out.join(block[k]);
     return mid;
   }
@@ -706,7 +639,7 @@ class BvhBuilder {
   uint32_t count_ = 0;
   std::unique_ptr<BuildNode[], FreeNodes> nodes_;
   std::atomic<uint32_t> node_count_{0};
-  mutable std::atomic<uint64_t> sync_{0};
+  TbbSync sync_;  // oneTBB's parallel calls, with edges ThreadSanitizer sees
 };
 
 }  // namespace
@@ -722,14 +655,10 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
       for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];
     };
     if (options.mode == BuildMode::Tasks && ids_.size() >= kParallelSplit) {
-      std::atomic<uint32_t> published{0};  // happens-before edges TSan can see (see publish())
-      published.fetch_add(1, std::memory_order_acq_rel);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, ids_.size(), kPartitionBlock), [&](const auto& r) {
-        published.fetch_add(1, std::memory_order_acq_rel);
-        copy(r.begin(), r.end());
-        published.fetch_add(1, std::memory_order_acq_rel);
+      const uint32_t blocks = uint32_t((ids_.size() + kPartitionBlock - 1) / kPartitionBlock);
+      TbbSync().for_each(blocks, [&](uint32_t k) {
+        copy(size_t(k) * kPartitionBlock, std::min(ids_.size(), size_t(k + 1) * kPartitionBlock));
       });
-      published.fetch_add(1, std::memory_order_acq_rel);
     } else {
       copy(0, ids_.size());
     }
