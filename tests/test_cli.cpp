@@ -235,7 +235,7 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
   // A brute-force render of a few thousand triangles at 2048x2048 runs for minutes; SIGINT after
   // a second must end it within a fraction of a second with exit code 130. --foreground: without
   // it `timeout` signals the child and then its whole process group, so the tracer gets SIGINT
-  // twice, and a second Ctrl-C kills at once by design (SA_RESETHAND), which made this test flaky.
+  // twice, and a second signal ends the process at once by design (no partial image then).
   const std::string scene = dir_ + "/many.obj";
   {
     std::ofstream f(scene);

@@ -513,7 +513,7 @@ class BvhBuilder {
       acc.join(odd);
     };
     // Sequentially the bins are filled in place: a BinSet is kilobytes, and copying it per node
-    // used to cost more than the binning itself.
+    // costs more than the binning itself.
     BinSet bins(nb);
     if (parallel) {
       bins = reduce_range(node.begin, node.end, true, BinSet(nb), [&](uint32_t b, uint32_t e, BinSet acc) {

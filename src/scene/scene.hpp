@@ -30,7 +30,8 @@ struct Triangle {
   bool degenerate() const;
 };
 
-// OBJ material; Ks, Ni and illum are kept for the mirror/glass work of later issues.
+// OBJ material. The study's workload shades with Kd and Ke only; Ks, Ni and illum are read and
+// kept with the material.
 struct Material {
   std::string name = "default";
   Vec3 kd{0.7f};
