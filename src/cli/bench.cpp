@@ -198,7 +198,17 @@ struct Cell {
   double mrays = 0;
   size_t triangles = 0;
   std::vector<double> run_ms;
+  bool capped(int runs) const { return !timed_out && int(run_ms.size()) < runs; }
 };
+
+std::string duration_text(double seconds) {
+  char b[64];
+  if (seconds < 120)
+    std::snprintf(b, sizeof b, "%.0f s", seconds);
+  else
+    std::snprintf(b, sizeof b, "%.1f min", seconds / 60.0);
+  return b;
+}
 
 double kbest_mean(std::vector<double> v, int best) {
   std::sort(v.begin(), v.end());
@@ -298,7 +308,9 @@ void add_bench_options(CLI::App& app, BenchArgs& a) {
   app.add_option("--runs", a.runs, "timed runs per cell")->capture_default_str();
   app.add_option("--best", a.best, "mean of the best k runs (the study's k-best rule)")->capture_default_str();
   app.add_option("--threads", a.threads, "threads for the parallel variants (default: all)");
-  app.add_option("--max-seconds", a.max_seconds, "stop a cell whose run exceeds this")->capture_default_str();
+  app.add_option("--max-seconds", a.max_seconds,
+                 "time cap per cell, all its runs together: later runs are skipped, a run at the cap is stopped")
+      ->capture_default_str();
   app.add_option("--json", a.json, "write raw figures as JSON");
   app.add_option("--plot", a.plot, "write a grouped bar chart (SVG, log scale)");
   app.add_option("--markdown", a.markdown, "also write the tables to this Markdown file");
@@ -330,6 +342,11 @@ int run_bench(const BenchArgs& a) {
   size_t done_cells = 0;
   const auto bench_start = Clock::now();
   const bool tty = ::isatty(STDERR_FILENO);
+  std::fprintf(
+      stderr,
+      "tracer bench: %zu cells (%zu scenes x %zu variants), up to %d runs each, at most %s s per cell: at most %s\n",
+      total_cells, scenes.size(), variants.size(), a.runs, fmt(a.max_seconds, 0).c_str(),
+      duration_text(double(total_cells) * a.max_seconds).c_str());
   for (const SceneEntry& se : scenes) {
     const auto t_load = Clock::now();
     const Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
@@ -342,7 +359,12 @@ int run_bench(const BenchArgs& a) {
       cell.triangles = scene.size();
       cell.load_ms = load_ms;
       std::vector<double> builds, renders;
+      const auto cell_start = Clock::now();
       for (int run = 0; run < a.runs && !cell.timed_out; ++run) {
+        // The cap bounds the whole cell: later runs are skipped once it is spent, and a run still
+        // going at the cap is stopped (the cell times out only if no run finished).
+        const double left = a.max_seconds - std::chrono::duration<double>(Clock::now() - cell_start).count();
+        if (run > 0 && left <= 0) break;
         if (tty || run == 0) {  // logs get one line per cell
           const double elapsed = std::chrono::duration<double>(Clock::now() - bench_start).count();
           const double frac = (double(done_cells) + double(run) / a.runs) / double(total_cells);
@@ -372,12 +394,12 @@ int run_bench(const BenchArgs& a) {
         const auto t0 = Clock::now();
         bool finished;
         {
-          Watchdog watchdog(stop, std::max(0.0, a.max_seconds - accel.build_ms / 1000.0));
+          Watchdog watchdog(stop, std::max(0.0, left - accel.build_ms / 1000.0));
           finished = render_image(accel, ctx, so, control);
         }
         const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         if (!finished) {
-          cell.timed_out = true;
+          cell.timed_out = run == 0;
           break;
         }
         builds.push_back(accel.build_ms);
@@ -417,7 +439,13 @@ int run_bench(const BenchArgs& a) {
   md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs
      << " runs, mean of best " << a.best << ", threads " << resolve_thread_count(threads) << "\n";
   header("Build + render time, ms (k-best mean)");
-  row([&](const SceneEntry&, const Variant&, const Cell& c) { return c.timed_out ? timeout_text : fmt(c.total_ms); });
+  row([&](const SceneEntry&, const Variant&, const Cell& c) {
+    return c.timed_out ? timeout_text : fmt(c.total_ms) + (c.capped(a.runs) ? "*" : "");
+  });
+  if (std::any_of(cells.begin(), cells.end(), [&](const auto& kv) { return kv.second.capped(a.runs); })) {
+    md << "\n\\* fewer than " << a.runs << " runs: the cell reached the " << fmt(a.max_seconds, 0)
+       << " s cap (--max-seconds); the mean is over the best of the runs it made.\n";
+  }
   header("Build time, ms");
   row([&](const SceneEntry&, const Variant&, const Cell& c) {
     return c.timed_out ? std::string("-") : fmt(c.build_ms, 2);

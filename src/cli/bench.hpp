@@ -19,7 +19,7 @@ struct BenchArgs {
   int ao = RenderSettings{}.ao_samples;
   int runs = 10, best = 3;
   std::optional<int> threads;  // empty: all hardware threads
-  double max_seconds = 60.0;
+  double max_seconds = 10.0;   // per cell, all runs together
   std::string json, plot, markdown;
   bool list = false;
 };
