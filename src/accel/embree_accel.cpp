@@ -113,4 +113,89 @@ bool EmbreeAccel::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
+namespace {
+
+// Lanes of a 16-wide Embree call: -1 where a ray is, 0 where none is.
+void valid_lanes(uint32_t active, int* valid) {
+  for (int k = 0; k < kPacketSize; ++k) valid[k] = (active >> k) & 1u ? -1 : 0;
+}
+
+void fill_ray16(RTCRay16& r, int k, const Ray& ray) {
+  r.org_x[k] = ray.org.x;
+  r.org_y[k] = ray.org.y;
+  r.org_z[k] = ray.org.z;
+  r.tnear[k] = ray.tnear;
+  r.dir_x[k] = ray.dir.x;
+  r.dir_y[k] = ray.dir.y;
+  r.dir_z[k] = ray.dir.z;
+  r.time[k] = 0.0f;
+  r.tfar[k] = ray.tfar;
+  r.mask[k] = 0xffffffffu;
+  r.id[k] = unsigned(k);
+  r.flags[k] = 0;
+}
+
+uint32_t occluded16(RTCScene scene, uint32_t active, RTCRay16& r, RTCIntersectContextFlags flags) {
+  alignas(64) int valid[kPacketSize];
+  valid_lanes(active, valid);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = flags;
+  rtcOccluded16(valid, scene, &context, &r);
+  uint32_t occluded = 0;
+  for (uint32_t bits = active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    if (r.tfar[k] < 0.0f) occluded |= 1u << k;  // Embree sets tfar to -inf on a hit
+  }
+  return occluded;
+}
+
+}  // namespace
+
+void EmbreeAccel::intersect_packet(const RayPacket& rays, Hit* hits) const {
+  alignas(64) RTCRayHit16 rh;
+  alignas(64) int valid[kPacketSize];
+  valid_lanes(rays.active, valid);
+  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    fill_ray16(rh.ray, k, rays.ray(k));
+    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // a 4x4 block of primary rays
+  rtcIntersect16(valid, rtc_scene_, &context, &rh);
+  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    hits[k] = Hit{};
+    if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+    hits[k].t = rh.ray.tfar[k];
+    hits[k].u = rh.hit.u[k];
+    hits[k].v = rh.hit.v[k];
+    hits[k].geomID = rh.hit.geomID[k];
+    hits[k].primID = rh.hit.primID[k];
+    hits[k].tri = scene_->geometries[rh.hit.geomID[k]].first_triangle + rh.hit.primID[k];
+  }
+}
+
+uint32_t EmbreeAccel::occluded_packet(const RayPacket& rays) const {
+  alignas(64) RTCRay16 r;
+  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    fill_ray16(r, k, rays.ray(k));
+  }
+  return occluded16(rtc_scene_, rays.active, r, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+}
+
+uint32_t EmbreeAccel::occluded_bundle_from(const RayBundle& rays, uint32_t) const {
+  alignas(64) RTCRay16 r;
+  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    fill_ray16(r, k, rays.ray(k));
+  }
+  return occluded16(rtc_scene_, rays.active, r, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+}
+
 }  // namespace tracer

@@ -78,7 +78,11 @@ const std::vector<Variant>& all_variants() {
       {"best", AccelKind::Bvh8, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
        "8-wide SIMD BVH (TBB build), primary-ray packets and AO bundles, TBB work stealing", false, true},
       {"embree", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
-       "Intel Embree 3, TBB work stealing", false},
+       "Intel Embree 3, single rays (rtcIntersect1/rtcOccluded1), TBB work stealing", false},
+      {"embree-packets", AccelKind::Embree, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "Intel Embree 3, packets: rtcIntersect16 per 4x4 block, rtcOccluded16 for its shadow rays and for each hit's "
+       "AO rays, TBB work stealing",
+       false, true},
   };
   return v;
 }
@@ -471,12 +475,14 @@ int run_bench(const BenchArgs& a) {
       return fmt(s.total_ms / c.total_ms, 1) + " / " + fmt(study_speedup, 1);
     });
   }
-  const bool have_embree =
-      std::any_of(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "embree"; });
-  if (have_embree) {
-    header("Throughput relative to Embree (Mrays/s ratio, same rays, same run)");
+  for (const auto& [reference, title] : {std::pair<std::string, std::string>{"embree", "Embree's single rays"},
+                                         {"embree-packets", "Embree's packet API"}}) {
+    const bool present =
+        std::any_of(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == reference; });
+    if (!present) continue;
+    header("Throughput relative to " + title + " (Mrays/s ratio, same rays, same run)");
     row([&](const SceneEntry& se, const Variant&, const Cell& c) {
-      const Cell& e = cells[{se.name, "embree"}];
+      const Cell& e = cells[{se.name, reference}];
       if (c.timed_out || e.timed_out || e.mrays <= 0) return std::string("-");
       return fmt(c.mrays / e.mrays, 2) + "x";
     });

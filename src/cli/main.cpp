@@ -54,10 +54,10 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
               j["ao_samples"].get<int>(), str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              j["packets"].get<bool>()
-                  ? (accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles"
-                                                   : ", AO rays in bundles")
-                  : "");
+              !j["packets"].get<bool>()         ? ""
+              : accel.kind == AccelKind::Bvh8   ? ", primary rays in 4x4 packets, AO rays in bundles"
+              : accel.kind == AccelKind::Embree ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
+                                                : ", AO rays in bundles");
   if (const std::optional<BvhStats> st = accel.bvh_stats()) {
     std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n",
                 st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);

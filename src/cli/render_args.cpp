@@ -87,8 +87,8 @@ void validate(const RenderArgs& a) {
   }
   for (const auto& l : a.scene.lights) parse_point("--light", l);
   const AccelOptions accel = accel_options_for(a);
-  if (s.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh) {
-    throw UsageError("--packets: needs --accel bvh or bvh8 (the accelerators with packet kernels)");
+  if (s.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh && accel.kind != AccelKind::Embree) {
+    throw UsageError("--packets: needs --accel bvh, bvh8 or embree (the accelerators with packet kernels)");
   }
   sched_options_for(a);
   simd_target_for(a);

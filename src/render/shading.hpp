@@ -7,6 +7,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <numbers>
 
@@ -78,13 +79,13 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
   return dot(d, n) < 0.0f ? -d : d;
 }
 
-// Accelerators that trace a RayPacket at once (the 8-wide BVH).
+// Accelerators that trace a RayPacket at once (the 8-wide BVH, Embree's packet API).
 template <class A>
 concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) {
   a.intersect_packet(p, h);
 };
 
-// Accelerators that answer the AO rays of one shading point as one bundle (both BVHs).
+// Accelerators that answer the AO rays of one shading point as one bundle (both BVHs, Embree).
 template <class A>
 concept BundleAccelerator = requires(const A& a, const RayBundle& b) {
   a.occluded_bundle_from(b, 0u);
@@ -101,52 +102,72 @@ bool occluded_leaving(const Accel& accel, const Ray& ray, uint32_t origin) {
   }
 }
 
-// The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
-template <class Accel>
-Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
-               RayCounts& counts) {
-  const Scene& scene = *ctx.scene;
-  const RenderSettings& s = ctx.settings;
-  if (!hit.valid()) return Vec3{0.0f};
+// Accelerators that answer a packet of unrelated occlusion rays at once (Embree's packet API).
+template <class A>
+concept OcclusionPacketAccelerator = requires(const A& a, const RayPacket& p) {
+  { a.occluded_packet(p) } -> std::same_as<uint32_t>;
+};
 
+// A primary hit being shaded: the normal on the side the camera sees, the origin of the rays it
+// sends, and the colour so far.
+struct SurfacePoint {
+  Vec3 n, origin, albedo_over_pi, color;
+  const Material* mat;
+  uint32_t tri, geomID;
+};
+
+inline SurfacePoint surface_point(const RenderContext& ctx, const Ray& primary, const Hit& hit) {
+  const Scene& scene = *ctx.scene;
   const Triangle& tri = scene.triangles[hit.tri];
-  const Material& mat = scene.materials[scene.tri_material[hit.tri]];
-  Vec3 n = normalize(tri.normal());
-  if (dot(n, primary.dir) > 0.0f) n = -n;  // shade the side the camera sees
+  SurfacePoint sp;
+  sp.mat = &scene.materials[scene.tri_material[hit.tri]];
+  sp.n = normalize(tri.normal());
+  if (dot(sp.n, primary.dir) > 0.0f) sp.n = -sp.n;  // shade the side the camera sees
   // Barycentric position: more precise than org + t*dir far from the camera.
   const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
-  const Vec3 origin = offset_origin(p, n);
-  const Vec3 albedo_over_pi = mat.kd * std::numbers::inv_pi_v<float>;
+  sp.origin = offset_origin(p, sp.n);
+  sp.albedo_over_pi = sp.mat->kd * std::numbers::inv_pi_v<float>;
+  sp.color = sp.mat->ke;
+  sp.tri = hit.tri;
+  sp.geomID = hit.geomID;
+  return sp;
+}
 
-  Vec3 color = mat.ke;
-  for (const Light& light : scene.lights) {
-    if (light.geomID == hit.geomID) continue;  // an emitter does not light itself
-    const Vec3 to_light = light.position - origin;
-    const float d2 = dot(to_light, to_light);
-    if (!(d2 > 0.0f)) continue;
-    const float d = std::sqrt(d2);
-    const Vec3 wi = to_light / d;
-    const float cos_surface = dot(n, wi);
-    if (cos_surface <= 0.0f) continue;
-    // Irradiance from a light of area A at distance d: power * cos_l / (d^2 + A/pi), exact on the
-    // axis of a disk of that area and free of the 1/d^2 blow-up near the lamp; 1/d^2 for points.
-    const float cos_light = light.is_point() ? 1.0f : std::fabs(dot(light.normal, wi));
-    const float falloff = cos_light / (d2 + light.area * std::numbers::inv_pi_v<float>);
-    Ray shadow;
-    shadow.org = origin;
-    shadow.dir = wi;
-    shadow.tfar = d * (1.0f - 1e-4f);  // stop short of the light's own surface
-    ++counts.shadow;
-    if (occluded_leaving(accel, shadow, hit.tri)) continue;
-    color += albedo_over_pi * light.power * (falloff * cos_surface);
-  }
+// The shadow ray from `sp` toward `light` and what the light adds if nothing blocks it; false
+// when the light cannot contribute (it is the surface's own emitter, or behind the surface).
+inline bool light_sample(const SurfacePoint& sp, const Light& light, Ray& shadow, Vec3& contribution) {
+  if (light.geomID == sp.geomID) return false;  // an emitter does not light itself
+  const Vec3 to_light = light.position - sp.origin;
+  const float d2 = dot(to_light, to_light);
+  if (!(d2 > 0.0f)) return false;
+  const float d = std::sqrt(d2);
+  const Vec3 wi = to_light / d;
+  const float cos_surface = dot(sp.n, wi);
+  if (cos_surface <= 0.0f) return false;
+  // Irradiance from a light of area A at distance d: power * cos_l / (d^2 + A/pi), exact on the
+  // axis of a disk of that area and free of the 1/d^2 blow-up near the lamp; 1/d^2 for points.
+  const float cos_light = light.is_point() ? 1.0f : std::fabs(dot(light.normal, wi));
+  const float falloff = cos_light / (d2 + light.area * std::numbers::inv_pi_v<float>);
+  shadow = Ray{};
+  shadow.org = sp.origin;
+  shadow.dir = wi;
+  shadow.tfar = d * (1.0f - 1e-4f);  // stop short of the light's own surface
+  contribution = sp.albedo_over_pi * light.power * (falloff * cos_surface);
+  return true;
+}
 
+// Adds the ambient term, scaled by the fraction of `sp`'s AO rays that escape, and returns the
+// pixel's colour.
+template <class Accel>
+Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfacePoint& sp,
+                         RayCounts& counts) {
+  const RenderSettings& s = ctx.settings;
   float unoccluded = 1.0f;
   if (s.ao_samples > 0) {
     const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
     const auto direction = [&](int i) {
       const SampleRng rng(pixel, uint32_t(i), s.seed);
-      return ao_direction(n, rng.draw(0), rng.draw(1));
+      return ao_direction(sp.n, rng.draw(0), rng.draw(1));
     };
     int open = 0;
     bool bundled = false;
@@ -155,11 +176,11 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
         // Up to 16 rays at a time; each gets the answer it gets alone, so the image is the same.
         for (int first = 0; first < s.ao_samples; first += kPacketSize) {
           RayBundle bundle;
-          bundle.org = origin;
+          bundle.org = sp.origin;
           bundle.tfar = s.ao_distance;
           const int count = std::min(kPacketSize, s.ao_samples - first);
           for (int k = 0; k < count; ++k) bundle.set_direction(k, direction(first + k));
-          open += count - std::popcount(accel.occluded_bundle_from(bundle, hit.tri));
+          open += count - std::popcount(accel.occluded_bundle_from(bundle, sp.tri));
         }
         bundled = true;
       }
@@ -167,17 +188,32 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
     if (!bundled) {
       for (int i = 0; i < s.ao_samples; ++i) {
         Ray ao;
-        ao.org = origin;
+        ao.org = sp.origin;
         ao.dir = direction(i);
         ao.tfar = s.ao_distance;
-        open += occluded_leaving(accel, ao, hit.tri) ? 0 : 1;
+        open += occluded_leaving(accel, ao, sp.tri) ? 0 : 1;
       }
     }
     counts.ao += uint64_t(s.ao_samples);
     unoccluded = float(open) / float(s.ao_samples);
   }
-  color += mat.kd * (s.ambient * unoccluded);
-  return color;
+  return sp.color + sp.mat->kd * (s.ambient * unoccluded);
+}
+
+// The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
+template <class Accel>
+Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
+               RayCounts& counts) {
+  if (!hit.valid()) return Vec3{0.0f};
+  SurfacePoint sp = surface_point(ctx, primary, hit);
+  for (const Light& light : ctx.scene->lights) {
+    Ray shadow;
+    Vec3 contribution;
+    if (!light_sample(sp, light, shadow, contribution)) continue;
+    ++counts.shadow;
+    if (!occluded_leaving(accel, shadow, sp.tri)) sp.color += contribution;
+  }
+  return finish_with_ambient(accel, ctx, x, y, sp, counts);
 }
 
 template <class Accel>
@@ -189,32 +225,72 @@ Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, Ray
   return shade_hit(accel, ctx, x, y, primary, hit, counts);
 }
 
+// A 4x4 pixel block at (bx, by), clipped to the tile: its primary rays as one packet, then per
+// light its shadow rays as one packet (one call where the accelerator takes occlusion packets),
+// then each hit's AO rays. Each ray gets the answer it gets alone and every pixel sums its lights
+// in the same order, so the image is the one shade_pixel() makes.
+template <class Accel>
+void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile, int bx, int by, RayCounts& counts) {
+  RayPacket packet;
+  Ray rays[kPacketSize];
+  for (int k = 0; k < kPacketSize; ++k) {
+    const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
+    if (x >= tile.x1 || y >= tile.y1) continue;
+    rays[k] = ctx.camera.primary_ray(x, y);
+    packet.set(k, rays[k]);
+  }
+  Hit hits[kPacketSize];
+  accel.intersect_packet(packet, hits);
+  counts.primary += uint64_t(std::popcount(packet.active));
+  SurfacePoint sps[kPacketSize];
+  uint32_t lit = 0;  // lanes that hit something
+  for (uint32_t bits = packet.active; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    if (!hits[k].valid()) {
+      ctx.framebuffer->at(bx + k % kPacketEdge, by + k / kPacketEdge) = Vec3{0.0f};
+      continue;
+    }
+    sps[k] = surface_point(ctx, rays[k], hits[k]);
+    lit |= 1u << k;
+  }
+  for (const Light& light : ctx.scene->lights) {
+    RayPacket shadows;
+    Vec3 contribution[kPacketSize];
+    for (uint32_t bits = lit; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      Ray shadow;
+      if (light_sample(sps[k], light, shadow, contribution[k])) shadows.set(k, shadow);
+    }
+    if (shadows.active == 0) continue;
+    counts.shadow += uint64_t(std::popcount(shadows.active));
+    uint32_t blocked = 0;
+    if constexpr (OcclusionPacketAccelerator<Accel>) {
+      blocked = accel.occluded_packet(shadows);
+    } else {
+      for (uint32_t bits = shadows.active; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        if (occluded_leaving(accel, shadows.ray(k), sps[k].tri)) blocked |= 1u << k;
+      }
+    }
+    for (uint32_t bits = shadows.active & ~blocked; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      sps[k].color += contribution[k];
+    }
+  }
+  for (uint32_t bits = lit; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
+    ctx.framebuffer->at(x, y) = finish_with_ambient(accel, ctx, x, y, sps[k], counts);
+  }
+}
+
 template <class Accel>
 RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile) {
   RayCounts counts;
   if constexpr (PacketAccelerator<Accel>) {
     if (ctx.settings.packets) {
-      // Primary rays 4x4 pixels at a time (fewer at the tile's right and bottom edges); each
-      // lane's hit is the one its ray gets alone, so the image does not change.
       for (int by = tile.y0; by < tile.y1; by += kPacketEdge) {
-        for (int bx = tile.x0; bx < tile.x1; bx += kPacketEdge) {
-          RayPacket packet;
-          Ray rays[kPacketSize];
-          for (int k = 0; k < kPacketSize; ++k) {
-            const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-            if (x >= tile.x1 || y >= tile.y1) continue;
-            rays[k] = ctx.camera.primary_ray(x, y);
-            packet.set(k, rays[k]);
-          }
-          Hit hits[kPacketSize];
-          accel.intersect_packet(packet, hits);
-          for (uint32_t bits = packet.active; bits; bits &= bits - 1) {
-            const int k = __builtin_ctz(bits);
-            const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-            ++counts.primary;
-            ctx.framebuffer->at(x, y) = shade_hit(accel, ctx, x, y, rays[k], hits[k], counts);
-          }
-        }
+        for (int bx = tile.x0; bx < tile.x1; bx += kPacketEdge) shade_block(accel, ctx, tile, bx, by, counts);
       }
       return counts;
     }
