@@ -42,6 +42,10 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ + "/empty.obj") << "# nothing\n";
     std::ofstream(dir_ + "/ok.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
     std::ofstream(dir_ + "/same.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
+    std::ofstream(dir_ + "/views.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\tnote\n"
+                                       << "tri\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\tthe triangle\n";
+    std::ofstream(dir_ + "/badviews.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\n"
+                                          << "tri\tok.obj\t0,0,3\t0,0\t0,1,0\t45\t0,0,2\n";
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string dir_;
@@ -90,11 +94,20 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"bench --size 32x32x99junk", 2, "--size: expected WxH (two whole numbers), got '32x32x99junk'"},
       {"bench --size 99999999999x2", 2, "--size width: must be between 1 and 16384, got 99999999999"},
       {"bench --threads 0", 2, "--threads: must be between 1 and 1024, got 0"},
+      {"render --view nope --views VIEWS", 1, "views.tsv: no view called 'nope' (tri)"},
+      {"render --view tri --views BADVIEWS", 1,
+       "badviews.tsv:2: look: expected x,y,z (three finite numbers), got '0,0'"},
+      {"render RANGE --view tri --views VIEWS", 2, "--view: the view names its scene"},
+      {"bench --scenes nope --views VIEWS", 1, "views.tsv: no view called 'nope'"},
   };
   for (const CliCase& c : cases) {
     std::string args = c.args;
-    for (const auto& [key, file] :
-         {std::pair{"NAN", "nan.obj"}, {"RANGE", "range.obj"}, {"EMPTY", "empty.obj"}, {"SAME", "same.obj"}}) {
+    for (const auto& [key, file] : {std::pair{"NAN", "nan.obj"},
+                                    {"RANGE", "range.obj"},
+                                    {"EMPTY", "empty.obj"},
+                                    {"SAME", "same.obj"},
+                                    {"BADVIEWS", "badviews.tsv"},
+                                    {"VIEWS", "views.tsv"}}) {
       for (size_t p = args.find(key); p != std::string::npos; p = args.find(key))
         args.replace(p, std::string(key).size(), dir_ + "/" + file);
     }
@@ -108,7 +121,9 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
     EXPECT_FALSE(fs::exists(dir_ + "/out.png"));
   }
   // No temporary files were left behind either.
-  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().extension(), ".obj") << entry.path();
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_TRUE(entry.path().extension() == ".obj" || entry.path().extension() == ".tsv") << entry.path();
+  }
 }
 
 TEST_F(Cli, OutputErrors) {
@@ -180,6 +195,24 @@ TEST_F(Cli, OneAllowedCoreRunsOneThreadWithoutWarnings) {
   ASSERT_EQ(::pclose(pipe), 0) << out;
   EXPECT_EQ(out.find("Warning"), std::string::npos) << out;
   EXPECT_NE(out.find("tbb, 1 threads"), std::string::npos) << out;
+}
+
+TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
+  // The view's camera and light, against the same given as flags: the same image.
+  auto r = test::run_tracer("render --view tri --views " + dir_ + "/views.tsv -q --width 24 --height 16 -o " + dir_ +
+                            "/v.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_tracer("render " + dir_ +
+                       "/ok.obj --eye 0,0,3 --look 0,0,0 --fov 45 --no-scene-lights --light 0,0,2 -q " +
+                       "--width 24 --height 16 -o " + dir_ + "/f.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/v.png").rgb, read_image(dir_ + "/f.png").rgb);
+  // bench times a view and, with --framed, the same scene framed from outside as its own row.
+  r = test::run_tracer("bench --scenes tri --views " + dir_ +
+                       "/views.tsv --framed --variants sah --size 8x8 --runs 1 --best 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("| Tri | 1 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| Tri (framed) | 1 |"), std::string::npos) << r.output;
 }
 
 TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {

@@ -28,6 +28,7 @@
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
+#include "scene/views.hpp"
 
 namespace tracer::cli {
 namespace {
@@ -137,36 +138,47 @@ const std::map<std::string, std::map<std::string, double>>& study_ms() {
   return m;
 }
 
+// One row of the tables: a view (camera and light from the views file), a scene framed from
+// outside its bounds (an OBJ path, or --framed), or the built-in box with its own camera.
 struct SceneEntry {
-  std::string name, path;
+  std::string name, path;    // path empty: the built-in box
+  std::optional<View> view;  // the camera and light, when the row is a view
 };
 
-std::string shared_scenes_dir() {
-  // From the project root or its build directory: ../shared/scenes.
-  for (const char* p : {"../shared/scenes", "../../shared/scenes", "../../../shared/scenes"}) {
-    if (std::filesystem::exists(std::string(p) + "/cornell-box")) return p;
-  }
-  return "../shared/scenes";
+// "cornell-original" -> "Original" (the study's names), "sponza" -> "Sponza".
+std::string display_name(const std::string& view) {
+  std::string n = view.rfind("cornell-", 0) == 0 ? view.substr(8) : view;
+  if (!n.empty()) n[0] = char(std::toupper(static_cast<unsigned char>(n[0])));
+  return n;
 }
 
-std::vector<SceneEntry> resolve_scenes(const std::string& spec) {
-  const std::string dir = shared_scenes_dir();
+std::vector<SceneEntry> resolve_scenes(const BenchArgs& a) {
+  const std::string views_path = a.views.empty() ? default_views_path() : a.views;
+  std::optional<std::vector<View>> views;
+  const auto all_views = [&]() -> const std::vector<View>& {
+    if (!views) views = load_views(views_path);
+    return *views;
+  };
   std::vector<SceneEntry> out;
-  for (const std::string& item : split_list("--scenes", spec)) {
-    if (item == "cornell" || item == "all") {
-      for (const char* n : {"Original", "Mirror", "Sphere", "Water"})
-        out.push_back({n, dir + "/cornell-box/CornellBox-" + n + ".obj"});
-    }
-    if (item == "large" || item == "all") {
-      out.push_back({"Sponza", dir + "/sponza/sponza.obj"});
-      out.push_back({"Sibenik", dir + "/sibenik/sibenik.obj"});
-      out.push_back({"Bunny", dir + "/bunny/bunny.obj"});
-    }
-    if (item == "builtin") out.push_back({"builtin", ""});
-    if (item != "cornell" && item != "large" && item != "all" && item != "builtin") {
+  const auto add_view = [&](const View& v) {
+    out.push_back({display_name(v.name), v.obj, v});
+    if (a.framed) out.push_back({display_name(v.name) + " (framed)", v.obj, std::nullopt});
+  };
+  for (const std::string& item : split_list("--scenes", a.scenes)) {
+    const bool cornell = item == "cornell", large = item == "large", all = item == "all";
+    if (cornell || large || all) {
+      for (const View& v : all_views()) {
+        const bool is_cornell = v.name.rfind("cornell-", 0) == 0;
+        if (all || is_cornell == cornell) add_view(v);
+      }
+    } else if (item == "builtin") {
+      out.push_back({"builtin", "", std::nullopt});
+    } else if (item.find('/') == std::string::npos && item.find('.') == std::string::npos) {
+      add_view(find_view(all_views(), item, views_path));
+    } else {
       std::string name = std::filesystem::path(item).stem().string();
       if (name.rfind("CornellBox-", 0) == 0) name = name.substr(11);  // the study's scene names
-      out.push_back({name, item});
+      out.push_back({name + " (framed)", item, std::nullopt});
     }
   }
   if (out.empty()) throw UsageError("--scenes: no scenes named");
@@ -306,7 +318,13 @@ std::string svg_chart(const std::vector<SceneEntry>& scenes, const std::vector<V
 
 void add_bench_options(CLI::App& app, BenchArgs& a) {
   app.add_option("--variants", a.variants, "variants: names, or study, ours, all")->capture_default_str();
-  app.add_option("--scenes", a.scenes, "scenes: OBJ paths, builtin, or cornell, large, all")->capture_default_str();
+  app.add_option(
+         "--scenes", a.scenes,
+         "scenes: view names from --views, or cornell, large, all (views); builtin; OBJ paths (framed from outside)")
+      ->capture_default_str();
+  app.add_option("--views", a.views,
+                 "views file: name, OBJ, camera and light per line (default ../shared/scenes/views.tsv)");
+  app.add_flag("--framed", a.framed, "also time each view's scene framed from outside its bounds, as a labelled row");
   app.add_option("--size", a.size, "image size WxH")->capture_default_str();
   app.add_option("--ao", a.ao, "AO rays per hit")->capture_default_str();
   app.add_option("--runs", a.runs, "timed runs per cell")->capture_default_str();
@@ -336,7 +354,7 @@ int run_bench(const BenchArgs& a) {
   const ThreadLimit thread_limit(threads);
   check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, true);
   const std::vector<Variant> variants = resolve_variants(a.variants);
-  const std::vector<SceneEntry> scenes = resolve_scenes(a.scenes);
+  const std::vector<SceneEntry> scenes = resolve_scenes(a);
   for (const std::string* out : {&a.json, &a.plot, &a.markdown}) {
     if (!out->empty()) check_writable(*out);
   }
@@ -353,9 +371,10 @@ int run_bench(const BenchArgs& a) {
       duration_text(double(total_cells) * a.max_seconds).c_str());
   for (const SceneEntry& se : scenes) {
     const auto t_load = Clock::now();
-    const Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
+    Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
+    if (se.view) apply_view_light(scene, *se.view);
     const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_load).count();
-    const CameraSpec cam = scene.camera ? *scene.camera : frame_bounds(scene.bounds);
+    const CameraSpec cam = se.view ? se.view->camera : scene.camera ? *scene.camera : frame_bounds(scene.bounds);
     for (const Variant& v : variants) {
       Cell cell;
       cell.scene = se.name;

@@ -14,7 +14,9 @@ namespace tracer::cli {
 
 struct BenchArgs {
   std::string variants = "study";  // comma list of names, or "study", "ours", "all"
-  std::string scenes = "cornell";  // comma list of paths/names, or "cornell", "large", "all"
+  std::string scenes = "cornell";  // comma list of view names or OBJ paths, or "cornell", "large", "all", "builtin"
+  std::string views;               // empty: ../shared/scenes/views.tsv
+  bool framed = false;             // also each view's scene framed from outside
   std::string size = "256x256";
   int ao = RenderSettings{}.ao_samples;
   int runs = 10, best = 3;

@@ -10,6 +10,7 @@
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
+#include "scene/views.hpp"
 
 namespace tracer::cli {
 
@@ -17,6 +18,8 @@ namespace fs = std::filesystem;
 
 void add_scene_options(CLI::App& app, SceneArgs& a) {
   app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)");
+  app.add_option("--view", a.view, "render a named view: its scene, camera and light (e.g. sponza, cornell-water)");
+  app.add_option("--views", a.views, "the views file for --view (default ../shared/scenes/views.tsv)");
   app.add_option("--builtin-spheres", a.builtin_spheres,
                  "built-in scene: add two spheres of about this many triangles each");
   app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
@@ -115,19 +118,37 @@ void check_outputs(const RenderArgs& a) {
   check_writable(a.stats_json);
 }
 
-Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
-  const WarningSink silent = [](const std::string&) {};
-  Scene scene =
-      a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, quiet ? silent : WarningSink{}, cancel);
+namespace {
+
+// --no-scene-lights and --light, on top of the scene's (or the view's) lights.
+void add_lights(Scene& scene, const SceneArgs& a) {
   if (a.no_scene_lights) scene.lights.clear();
-  const float diag = length(scene.bounds.extent());
-  const float intensity = a.light_intensity ? float(*a.light_intensity) : 0.25f * diag * diag;
+  const float intensity = a.light_intensity ? float(*a.light_intensity) : scene.default_light_intensity();
   for (const std::string& text : a.lights) {
     Light l;
     l.position = parse_point("--light", text);
     l.power = Vec3{intensity};
     scene.lights.push_back(l);
   }
+}
+
+}  // namespace
+
+Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
+  const WarningSink silent = [](const std::string&) {};
+  const WarningSink warn = quiet ? silent : WarningSink{};
+  if (!a.view.empty()) {
+    if (!a.scene.empty()) throw UsageError("--view: the view names its scene; give either a scene or --view");
+    const std::string path = a.views.empty() ? default_views_path() : a.views;
+    const View view = find_view(load_views(path), a.view, path);
+    Scene scene = load_obj(view.obj, warn, cancel);
+    apply_view_light(scene, view);
+    scene.camera = view.camera;
+    add_lights(scene, a);
+    return scene;
+  }
+  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel);
+  add_lights(scene, a);
   return scene;
 }
 

@@ -17,6 +17,8 @@ namespace tracer::cli {
 
 struct SceneArgs {
   std::string scene;  // empty: the built-in Cornell box
+  std::string view;   // a view of the views file: its scene, camera and light
+  std::string views;  // empty: ../shared/scenes/views.tsv
   int builtin_spheres = 0;
   std::vector<std::string> lights;
   bool no_scene_lights = false;

@@ -80,6 +80,11 @@ struct Scene {
   std::optional<CameraSpec> camera;  // a camera the scene itself suggests (the built-in box)
 
   size_t size() const { return triangles.size(); }
+  // The intensity of a point light when none is given (--light, a view's light): (diagonal / 2)^2.
+  float default_light_intensity() const {
+    const float diag = length(bounds.extent());
+    return 0.25f * diag * diag;
+  }
   // Appends a geometry from an indexed mesh; material is an index into `materials`.
   void add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
                 uint32_t material);
