@@ -218,7 +218,7 @@ void register_dynamic() {
         std::shared_ptr<Accelerator> accel;  // null: not built in
       };
       const Named singles_on[] = {
-          {"bvh-sah", std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{}))},
+          {"bvh-sah", std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Bvh}))},
           {"bvh8", wide},
           {"embree", embree_available() ? std::make_shared<Accelerator>(
                                               build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}))
@@ -241,7 +241,7 @@ void register_dynamic() {
             ->Unit(benchmark::kMillisecond);
       }
     }
-    std::vector<std::pair<std::string, AccelOptions>> accels = {{"bvh-sah", AccelOptions{}}};
+    std::vector<std::pair<std::string, AccelOptions>> accels = {{"bvh-sah", AccelOptions{.kind = AccelKind::Bvh}}};
     AccelOptions median;
     median.bvh.split = BvhSplit::Median;
     accels.emplace_back("bvh-median", median);

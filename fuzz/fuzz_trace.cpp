@@ -54,7 +54,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   if (!std::isfinite(length(scene.bounds.extent()))) return 0;
   const BruteForce reference(scene);
-  AccelOptions sah, median, wide, simd;
+  AccelOptions sah{.kind = AccelKind::Bvh}, median{.kind = AccelKind::Bvh}, wide, simd;
   median.bvh.split = BvhSplit::Median;
   wide.kind = AccelKind::Bvh8;
   simd.kind = AccelKind::BruteSimd;

@@ -334,7 +334,7 @@ TEST(BvhBuild, CancelFlagStopsEveryBuilderAndEmbree) {
     EXPECT_THROW(build_accelerator(scene, o), Cancelled);
   }
   cancel = false;  // and an unset flag changes nothing
-  AccelOptions o;
+  AccelOptions o{.kind = AccelKind::Bvh};
   o.bvh.cancel = &cancel;
   EXPECT_EQ(std::get<Bvh>(*build_accelerator(scene, o).impl).validate(), "");
 }

@@ -215,6 +215,27 @@ TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
   EXPECT_NE(r.output.find("| Tri (framed) | 1 |"), std::string::npos) << r.output;
 }
 
+TEST_F(Cli, DefaultIsTheFastestPathWithTheScalarImage) {
+  // No flags: the 8-wide BVH with packets and bundles; the same image as the scalar binary BVH
+  // tracing every ray alone. --simd off alone asks for that scalar tree.
+  const std::string common = " -q --width 24 --height 20 --ao 4";
+  auto r = test::run_tracer("render" + common + " --stats-json " + dir_ + "/d.json -o " + dir_ + "/d.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir_ + "/d.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["accel"].get<std::string>().rfind("bvh8", 0), 0u) << j.dump();
+  EXPECT_TRUE(j["packets"].get<bool>());
+  r = test::run_tracer("render" + common + " --accel bvh --no-packets -o " + dir_ + "/s.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/d.png").rgb, read_image(dir_ + "/s.png").rgb);
+  r = test::run_tracer("render" + common + " --simd off --stats-json " + dir_ + "/o.json -o " + dir_ + "/o.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in2(dir_ + "/o.json");
+  const nlohmann::json k = nlohmann::json::parse(in2);
+  EXPECT_EQ(k["accel"], "bvh-sah");
+  EXPECT_FALSE(k["packets"].get<bool>()) << "--simd off: no SIMD bundles either";
+}
+
 TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {
   const std::string ref = dir_ + "/ref.png";
   ASSERT_EQ(test::run_tracer("render " + dir_ + "/ok.obj -q --width 16 --height 16 -o " + ref).exit_code, 0);

@@ -68,7 +68,7 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
   const int size = int(test::ray_budget(100'000) >= 100'000 ? 48 : 24);
   for (const Scene& scene : scenes()) {
     SCOPED_TRACE(scene.source);
-    const Accelerator acc = build_accelerator(scene, AccelOptions{});
+    const Accelerator acc = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     SchedOptions seq;
     seq.kind = SchedKind::Seq;
     const Rendered reference = render_with(scene, acc, seq, size);
@@ -102,9 +102,10 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
     SCOPED_TRACE(scene.source);
     SchedOptions seq;
     seq.kind = SchedKind::Seq;
-    const Rendered reference = render_with(scene, build_accelerator(scene, AccelOptions{}), seq, size);
+    const Rendered reference =
+        render_with(scene, build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh}), seq, size);
     const Accelerator wide = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh8});
-    const Accelerator binary = build_accelerator(scene, AccelOptions{});
+    const Accelerator binary = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
       for (const int variant : {0, 1, 2}) {
         const bool packets = variant > 0;
@@ -125,7 +126,7 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
 
 TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
   const Scene scene = make_cornell_box(0);
-  const Accelerator acc = build_accelerator(scene, AccelOptions{});
+  const Accelerator acc = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
   for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
     SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)));
     RenderSettings s;

@@ -97,7 +97,7 @@ void expect_no_leaks(const IndexedMesh& mesh, Vec3 inside, float jitter) {
   std::vector<Vec3> targets(rays.size());  // the points the rays aim at, for the bundles
   for (size_t i = 0; i < rays.size(); ++i) targets[i] = rays[i].org + rays[i].dir;
   for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
-    AccelOptions o;
+    AccelOptions o{.kind = AccelKind::Bvh};
     o.bvh.split = split;
     const Accelerator acc = build_accelerator(scene, o);
     EXPECT_EQ(leaks(acc, rays), 0u) << acc.name << " over " << rays.size() << " rays";

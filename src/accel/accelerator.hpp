@@ -31,7 +31,7 @@ inline constexpr EnumName<AccelKind> kAccelKindNames[] = {
     {AccelKind::BruteSimd, "brute"}, {AccelKind::Bvh, "bvh"}, {AccelKind::Bvh8, "bvh8"}, {AccelKind::Embree, "embree"}};
 
 struct AccelOptions {
-  AccelKind kind = AccelKind::Bvh;
+  AccelKind kind = AccelKind::Bvh8;  // the fastest (docs/BENCHMARKS.md section 1)
   BvhBuildOptions bvh;
 };
 
@@ -58,6 +58,11 @@ struct Accelerator {
 };
 
 bool embree_available();
+
+// Whether `kind` traces packets or bundles (--packets): the BVHs and Embree.
+inline bool has_packet_kernels(AccelKind kind) {
+  return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || kind == AccelKind::Embree;
+}
 
 // Builds the accelerator `options` asks for, timing the build. Throws UsageError if it is not
 // compiled in (Embree).

@@ -41,7 +41,9 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--ambient", s.ambient, "ambient light strength")->capture_default_str();
   app.add_option("--exposure", s.exposure, "tone-mapping exposure")->capture_default_str();
   app.add_option("--seed", s.seed, "seed of the AO sample pattern")->capture_default_str();
-  app.add_option("--accel", a.accel, "accelerator: " + names_of<AccelKind>(kAccelKindNames))->capture_default_str();
+  app.add_option("--accel", a.accel,
+                 "accelerator: " + names_of<AccelKind>(kAccelKindNames) + " (default " +
+                     std::string(name_of<AccelKind>(kAccelKindNames, AccelOptions{}.kind)) + ", the fastest)");
   app.add_option("--bvh-split", a.split, "BVH split: " + names_of<BvhSplit>(kBvhSplitNames) + " (the study's)")
       ->capture_default_str();
   app.add_option("--build", a.build, "BVH build: " + names_of<BuildMode>(kBuildModeNames))->capture_default_str();
@@ -56,9 +58,10 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
          "--simd-target", a.simd_target,
          "bvh8 kernels: " + names_of<SimdTarget>(kSimdTargetNames) + " (force a narrower target than the CPU's)")
       ->capture_default_str();
-  app.add_flag("--packets", s.packets,
-               "trace rays together: each hit's AO rays as one bundle (bvh, bvh8), primary rays in 4x4-pixel packets "
-               "(bvh8); same image");
+  app.add_flag("--packets", a.packets,
+               "trace rays together: each hit's AO rays as one bundle (bvh, bvh8, embree), primary rays and shadow "
+               "rays per 4x4-pixel block (bvh8, embree); same image (default: on where the accelerator can)");
+  app.add_flag("--no-packets", a.no_packets, "trace every ray alone (same image, slower)")->excludes("--packets");
   app.add_option("--sched", a.sched_kind, "scheduler: " + names_of<SchedKind>(kSchedKindNames))->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.sched.tile, "tile edge in pixels for the atomic and tbb schedulers")
@@ -90,7 +93,7 @@ void validate(const RenderArgs& a) {
   }
   for (const auto& l : a.scene.lights) parse_point("--light", l);
   const AccelOptions accel = accel_options_for(a);
-  if (s.packets && accel.kind != AccelKind::Bvh8 && accel.kind != AccelKind::Bvh && accel.kind != AccelKind::Embree) {
+  if (a.packets && !has_packet_kernels(accel.kind)) {
     throw UsageError("--packets: needs --accel bvh, bvh8 or embree (the accelerators with packet kernels)");
   }
   sched_options_for(a);
@@ -180,6 +183,9 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a) {
   RenderSettings s = a.settings;
   if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
+  // Packets by default where the accelerator has them, but not under --simd off (all scalar).
+  const bool by_default = s.packets && !a.no_packets && a.simd != "off";
+  s.packets = (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind);
   return s;
 }
 
@@ -188,7 +194,10 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   o.bvh = a.bvh;
   const std::string simd = a.simd;
   if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
-  o.kind = parse_name<AccelKind>(kAccelKindNames, a.accel, "--accel", "accelerator");
+
+  // --simd off alone asks for the scalar baseline: the binary BVH, not the SIMD default.
+  const AccelKind fallback = simd == "off" ? AccelKind::Bvh : o.kind;
+  o.kind = a.accel ? parse_name<AccelKind>(kAccelKindNames, *a.accel, "--accel", "accelerator") : fallback;
   if (o.kind == AccelKind::BruteSimd && simd == "off") o.kind = AccelKind::Brute;
   if (o.kind == AccelKind::Bvh8 && simd == "off") {
     throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");

@@ -35,7 +35,8 @@ struct RenderArgs {
   std::string eye, look, up;
   std::optional<double> fov;
   std::optional<double> ao_distance;
-  std::string accel{name_of<AccelKind>(kAccelKindNames, AccelOptions{}.kind)};
+  std::optional<std::string> accel;          // empty: the library's default (scalar bvh with --simd off)
+  bool packets = false, no_packets = false;  // neither: packets where the accelerator can
   std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
   std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
   std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};

@@ -29,7 +29,9 @@ struct RenderSettings {
   float ambient = 0.25f;          // ambient light, times Kd and the unoccluded AO fraction
   float exposure = 1.5f;          // tone-mapping exposure
   uint32_t seed = 0;
-  bool packets = false;  // primary rays in 4x4-pixel packets (accelerators that have them)
+  // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
+  // shadow rays, each hit's AO rays as one bundle): the same image, faster.
+  bool packets = true;
 };
 
 struct RayCounts {
