@@ -487,7 +487,7 @@ int run_bench(const BenchArgs& a) {
     });
     header("Study comparison: speedup over seq, ours / study's");
     row([&](const SceneEntry& se, const Variant& v, const Cell& c) {
-      const auto sit = study_ms().find(se.name);
+      const auto sit = study_ms().find(se.name.substr(0, se.name.find(" (framed)")));
       const Cell& s = cells[{se.name, "seq"}];
       if (sit == study_ms().end() || !sit->second.count(v.name) || c.timed_out || s.timed_out) return std::string("-");
       const double study_speedup = sit->second.at("seq") / sit->second.at(v.name);

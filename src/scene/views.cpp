@@ -46,7 +46,8 @@ Vec3 parse_field_vec3(const std::string& text, const std::string& where, const c
 }  // namespace
 
 std::string default_views_path() {
-  for (const char* p : {"../shared/scenes/views.tsv", "../../shared/scenes/views.tsv", "../../../shared/scenes/views.tsv"}) {
+  for (const char* p :
+       {"../shared/scenes/views.tsv", "../../shared/scenes/views.tsv", "../../../shared/scenes/views.tsv"}) {
     if (std::filesystem::exists(p)) return p;
   }
   return "../shared/scenes/views.tsv";
@@ -63,7 +64,8 @@ std::vector<View> load_views(const std::string& path) {
     const std::vector<std::string> f = split_tabs(line);
     if (line_no == 1 && !f.empty() && f[0] == "scene") return;  // the header
     if (f.size() < 7) {
-      throw InputError(where + ": expected 7 or 8 tab-separated fields (scene, obj, eye, look, up, fov, light, note), got " +
+      throw InputError(where +
+                       ": expected 7 or 8 tab-separated fields (scene, obj, eye, look, up, fov, light, note), got " +
                        std::to_string(f.size()));
     }
     View v;
