@@ -24,16 +24,22 @@ mkdir -p "$O"
   echo '```'
 } > "$O/machine.md"
 
+# The views people render, against Embree's single rays and its packet API, at 1 and 2 threads.
+for t in 1 2; do
+  $T bench --scenes all --variants tbb+sah,bvh8,best,embree,embree-packets --size 1024x1024 --ao 16 --runs 3 --best 2 \
+    --threads $t --max-seconds 300 --json "$O/views-t$t.json" --markdown "$O/views-t$t.md"
+done
+
 # 1. The study's table: its ten variants (simd-brute is its ISPC column) plus ours and Embree.
-$T bench --scenes cornell --variants study,sah,tbb+sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
+$T bench --scenes cornell --framed --variants study,sah,tbb+sah,best,embree --size 128x128 --ao 4 --runs 10 --best 3 \
   --max-seconds 300 --json "$O/study.json" --markdown "$O/study.md" --plot "$O/study.svg"
 
 # The study's ISPC column: brute force eight triangles per SIMD pass, one thread.
-$T bench --scenes cornell --variants seq,simd-brute --size 128x128 --ao 4 --runs 10 --best 3 --max-seconds 300 --markdown "$O/simd-brute.md"
+$T bench --scenes cornell --framed --variants seq,simd-brute --size 128x128 --ao 4 --runs 10 --best 3 --max-seconds 300 --markdown "$O/simd-brute.md"
 
 # 2. Schedulers at 1 and 2 threads (SAH BVH), and the per-task overhead on a near-empty scene.
 for t in 1 2; do
-  $T bench --scenes cornell,../shared/scenes/sponza/sponza.obj --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah \
+  $T bench --scenes cornell,sponza --framed --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah \
     --size 512x512 --ao 16 --runs 5 --best 3 --threads $t --max-seconds 300 --json "$O/sched-t$t.json" --markdown "$O/sched-t$t.md"
 done
 $T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah,tbb+sah --size 2048x2048 --ao 0 \
@@ -42,11 +48,11 @@ $T bench --scenes "$O/near-empty.obj" --variants sah,async+sah,lq+sah,atomic+sah
 # 3. Our trees against Embree on every scene, at 1 and 2 threads; then the SIMD issue's workload
 #    (1024x1024, 16 AO rays) for the 8-wide BVH with and without primary-ray packets.
 for t in 1 2; do
-  $T bench --scenes cornell,large --variants bvh,sah,tbb+sah,bvh8,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t --max-seconds 300 \
+  $T bench --scenes cornell,large --framed --variants bvh,sah,tbb+sah,bvh8,best,embree --size 512x512 --ao 16 --runs 5 --best 3 --threads $t --max-seconds 300 \
     --json "$O/embree-t$t.json" --markdown "$O/embree-t$t.md" --plot "$O/embree-t$t.svg"
 done
 for t in 1 2; do
-  $T bench --scenes cornell,large --variants bvh8,best,embree --size 1024x1024 --ao 16 --runs 3 --best 2 --threads $t --max-seconds 300 \
+  $T bench --scenes cornell,large --framed --variants bvh8,best,embree --size 1024x1024 --ao 16 --runs 3 --best 2 --threads $t --max-seconds 300 \
     --json "$O/simd-1024-t$t.json" --markdown "$O/simd-1024-t$t.md"
 done
 
