@@ -10,7 +10,7 @@ PACKAGES=(
   g++ clang cmake ninja-build pkg-config git ca-certificates
   libtinyobjloader-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
-  libclang-rt-14-dev llvm clang-format nlohmann-json3-dev
+  libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
 )
 
 missing=()

@@ -1,6 +1,7 @@
 // Images: an analytic Lambert answer, golden images of the study's scenes, determinism.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <numbers>
 
@@ -114,6 +115,50 @@ TEST(Render, GoldenImages) {
     const Image8 got = read_image(out);
     EXPECT_EQ(golden.rgb, got.rgb) << "PSNR " << test::psnr(golden, got) << " dB";
   }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Exr, LinearRadianceRoundTripsAsFloatAndAsHalf) {
+  // Values a render holds: zero, tiny, ordinary, above 1, large, in a 5x3 image (rows and
+  // columns distinguishable). Float round-trips exactly; half within its 11-bit precision.
+  Framebuffer fb(5, 3);
+  const float values[] = {0.0f,    1e-4f, 0.18f, 0.5f,   1.0f,  3.75f, 17.0f, 1000.0f,
+                          0.0312f, 2.5f,  7.0f,  0.001f, 64.0f, 0.9f,  42.0f};
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) {
+      const float v = values[y * 5 + x];
+      fb.at(x, y) = Vec3{v, 2.0f * v, 0.5f * v};
+    }
+  const std::string dir = test::temp_dir();
+  for (const ExrPixel pixel : {ExrPixel::Float, ExrPixel::Half}) {
+    SCOPED_TRACE(std::string(name_of<ExrPixel>(kExrPixelNames, pixel)));
+    write_render(dir + "/x.exr", fb, 1.5f, pixel);
+    const Framebuffer back = read_exr(dir + "/x.exr");
+    ASSERT_EQ(back.width(), 5);
+    ASSERT_EQ(back.height(), 3);
+    const float tolerance = pixel == ExrPixel::Float ? 0.0f : 1.0f / 2048.0f;  // half: 11 significant bits
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x) {
+        const Vec3 a = fb.at(x, y), b = back.at(x, y);
+        for (int c = 0; c < 3; ++c)
+          EXPECT_LE(std::fabs(a[c] - b[c]), tolerance * std::fabs(a[c]) + 1e-7f) << x << "," << y;
+      }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Exr, TheCliWritesTheRadianceThePngToneMaps) {
+  // A float EXR of a render, tone-mapped here, equals the PNG of the same render byte for byte.
+  const std::string dir = test::temp_dir();
+  auto r = test::run_tracer("render -q --width 40 --height 30 --ao 4 --exr float -o " + dir + "/r.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_tracer("render -q --width 40 --height 30 --ao 4 -o " + dir + "/r.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(tonemap(read_exr(dir + "/r.exr"), 1.5f).rgb, read_image(dir + "/r.png").rgb);
+  r = test::run_tracer("render -q --width 8 --height 8 --exr double -o " + dir + "/bad.exr");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--exr: unknown pixel type 'double' (half, float)"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad.exr"));
   std::filesystem::remove_all(dir);
 }
 

@@ -110,7 +110,7 @@ int cmd_render(const RenderArgs& args) {
   const double render_ms = ms_since(t_render);
   if (!finished) {
     if (args.save_partial && control.pixels_done.load() > 0) {
-      write_image(args.output, tonemap(fb, settings.exposure));
+      write_render(args.output, fb, settings.exposure, exr_pixel_for(args));
       std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << args.output << "\n";
     } else {
       std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
@@ -118,7 +118,7 @@ int cmd_render(const RenderArgs& args) {
     }
     return exit_code_for_stop();
   }
-  write_image(args.output, tonemap(fb, settings.exposure));
+  write_render(args.output, fb, settings.exposure, exr_pixel_for(args));
   if (stop_signal() != 0) {  // arrived during the final write, which is never torn
     std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output
               << "\n";
@@ -160,9 +160,12 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "tracer 0.1.0");
 
   RenderArgs render_args;
-  CLI::App* render = app.add_subcommand("render", "render a scene to a PNG or PPM image");
+  CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image");
   add_render_options(*render, render_args);
-  render->add_option("-o,--output", render_args.output, "output image, .png or .ppm")->capture_default_str();
+  render
+      ->add_option("-o,--output", render_args.output,
+                   "output image: .png or .ppm (tone-mapped), .exr (linear radiance)")
+      ->capture_default_str();
   render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
   render->add_option("--stats-json", render_args.stats_json, "write the statistics as JSON to this file");
   render->add_flag("-q,--quiet", render_args.quiet, "no progress bar, no loader warnings");

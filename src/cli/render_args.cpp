@@ -39,7 +39,9 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--ao", s.ao_samples, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
   app.add_option("--ao-distance", a.ao_distance, "maximum distance of AO rays (default: unbounded)");
   app.add_option("--ambient", s.ambient, "ambient light strength")->capture_default_str();
-  app.add_option("--exposure", s.exposure, "tone-mapping exposure")->capture_default_str();
+  app.add_option("--exposure", s.exposure, "tone-mapping exposure of .png and .ppm outputs")->capture_default_str();
+  app.add_option("--exr", a.exr, "pixel type of .exr outputs (linear radiance, no tone mapping): half or float")
+      ->capture_default_str();
   app.add_option("--seed", s.seed, "seed of the AO sample pattern")->capture_default_str();
   app.add_option("--accel", a.accel,
                  "accelerator: " + names_of<AccelKind>(kAccelKindNames) + " (default " +
@@ -98,6 +100,7 @@ void validate(const RenderArgs& a) {
   }
   sched_options_for(a);
   simd_target_for(a);
+  exr_pixel_for(a);
 }
 
 // Two paths name the same file: the same inode if both exist, else the same absolute path.
@@ -213,6 +216,10 @@ SchedOptions sched_options_for(const RenderArgs& a) {
   o.kind = parse_name<SchedKind>(kSchedKindNames, a.sched_kind, "--sched", "scheduler");
   o.threads = a.threads.value_or(0);
   return o;
+}
+
+ExrPixel exr_pixel_for(const RenderArgs& a) {
+  return parse_name<ExrPixel>(kExrPixelNames, a.exr, "--exr", "pixel type");
 }
 
 SimdTarget simd_target_for(const RenderArgs& a) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 #include "render/shading.hpp"
 #include "scene/scene.hpp"
@@ -41,6 +42,7 @@ struct RenderArgs {
   std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
   std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};
   std::string simd = "auto";
+  std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
   std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
   std::optional<int> threads;
   std::string output = "render.png";
@@ -61,6 +63,7 @@ RenderSettings settings_for(const RenderArgs& args);
 AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);
+ExrPixel exr_pixel_for(const RenderArgs& args);
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);
 

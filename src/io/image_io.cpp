@@ -43,7 +43,8 @@ ImageFormat image_format_for(const std::string& path, const std::string& flag) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext == ".png") return ImageFormat::Png;
   if (ext == ".ppm") return ImageFormat::Ppm;
-  throw UsageError(flag + ": unsupported image extension '" + ext + "' in '" + path + "' (use .png or .ppm)");
+  if (ext == ".exr") return ImageFormat::Exr;
+  throw UsageError(flag + ": unsupported image extension '" + ext + "' in '" + path + "' (use .png, .ppm or .exr)");
 }
 
 void check_writable(const std::string& path) {
@@ -83,6 +84,9 @@ void write_file_atomic(const std::string& path, std::string_view bytes) {
 }
 
 void write_image(const std::string& path, const Image8& image) {
+  if (image_format_for(path) == ImageFormat::Exr) {
+    throw UsageError(path + ": an EXR holds linear radiance, not a tone-mapped image (write_render)");
+  }
   std::string bytes;
   if (image_format_for(path) == ImageFormat::Ppm) {
     bytes = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
@@ -100,6 +104,14 @@ void write_image(const std::string& path, const Image8& image) {
 
 void remove_pending_temp_file() {
   if (g_pending.load()) ::unlink(g_pending_temp);
+}
+
+void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel) {
+  if (image_format_for(path) == ImageFormat::Exr) {
+    write_file_atomic(path, encode_exr(fb, exr_pixel));
+  } else {
+    write_image(path, tonemap(fb, exposure));
+  }
 }
 
 Image8 read_image(const std::string& path) {

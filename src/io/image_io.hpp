@@ -5,17 +5,22 @@
 #include <string>
 #include <string_view>
 
+#include "io/exr_io.hpp"
 #include "render/framebuffer.hpp"
 
 namespace tracer {
 
-enum class ImageFormat { Png, Ppm };
+enum class ImageFormat { Png, Ppm, Exr };
 
-// From the path's extension (.png or .ppm, any case); throws UsageError naming `flag` otherwise.
+// From the path's extension (.png, .ppm or .exr, any case); throws UsageError naming `flag` otherwise.
 ImageFormat image_format_for(const std::string& path, const std::string& flag = "-o");
 
 // Encodes and writes; throws InputError("PATH: cannot write: reason") on failure.
 void write_image(const std::string& path, const Image8& image);
+
+// Writes a render in the format the path names: PNG and PPM tone-mapped with `exposure`, EXR as
+// linear radiance (half or float), no tone mapping.
+void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel);
 
 // Writes bytes to path via temp file + rename; throws InputError on failure.
 void write_file_atomic(const std::string& path, std::string_view bytes);

@@ -1,0 +1,124 @@
+#include "io/exr_io.hpp"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <half.h>
+
+#include <cstring>
+#include <exception>
+#include <vector>
+
+#include "base/errors.hpp"
+
+namespace tracer {
+namespace {
+
+// OpenEXR writes through a stream; this one keeps the bytes in memory, so the file itself is
+// written atomically like every other output (write_file_atomic).
+class MemoryStream : public Imf::OStream {
+ public:
+  MemoryStream() : Imf::OStream("memory") {}
+  void write(const char c[], int n) override {
+    if (pos_ + size_t(n) > bytes_.size()) bytes_.resize(pos_ + size_t(n));
+    std::memcpy(bytes_.data() + pos_, c, size_t(n));
+    pos_ += size_t(n);
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = size_t(pos); }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  std::string bytes_;
+  size_t pos_ = 0;
+};
+
+template <class T>
+void add_channels(Imf::Header& header, Imf::FrameBuffer& frame, std::vector<T>& planes, int w, int h,
+                  Imf::PixelType type) {
+  const size_t n = size_t(w) * size_t(h);
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    header.channels().insert(names[c], Imf::Channel(type));
+    frame.insert(names[c], Imf::Slice(type, reinterpret_cast<char*>(planes.data() + size_t(c) * n), sizeof(T),
+                                      sizeof(T) * size_t(w)));
+  }
+}
+
+template <class T>
+std::vector<T> planar(const Framebuffer& fb) {
+  const size_t n = size_t(fb.width()) * size_t(fb.height());
+  std::vector<T> planes(3 * n);
+  for (int y = 0; y < fb.height(); ++y) {
+    for (int x = 0; x < fb.width(); ++x) {
+      const Vec3& p = fb.at(x, y);
+      const size_t i = size_t(y) * size_t(fb.width()) + size_t(x);
+      planes[i] = T(p.x);
+      planes[n + i] = T(p.y);
+      planes[2 * n + i] = T(p.z);
+    }
+  }
+  return planes;
+}
+
+}  // namespace
+
+std::string encode_exr(const Framebuffer& fb, ExrPixel pixel) {
+  try {
+    Imf::Header header(fb.width(), fb.height());
+    header.compression() = Imf::ZIP_COMPRESSION;
+    Imf::FrameBuffer frame;
+    std::vector<half> halves;
+    std::vector<float> floats;
+    if (pixel == ExrPixel::Half) {
+      halves = planar<half>(fb);
+      add_channels(header, frame, halves, fb.width(), fb.height(), Imf::HALF);
+    } else {
+      floats = planar<float>(fb);
+      add_channels(header, frame, floats, fb.width(), fb.height(), Imf::FLOAT);
+    }
+    MemoryStream stream;
+    {
+      Imf::OutputFile file(stream, header);
+      file.setFrameBuffer(frame);
+      file.writePixels(fb.height());
+    }
+    return stream.take();
+  } catch (const std::exception& e) {
+    throw InputError(std::string("EXR encoding failed: ") + e.what());
+  }
+}
+
+Framebuffer read_exr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
+    std::vector<float> planes(3 * size_t(w) * size_t(h));
+    Imf::FrameBuffer frame;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+      char* base = reinterpret_cast<char*>(planes.data() + size_t(c) * size_t(w) * size_t(h));
+      base -= (size_t(window.min.x) + size_t(window.min.y) * size_t(w)) * sizeof(float);
+      frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+    }
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    Framebuffer fb(w, h);
+    const size_t n = size_t(w) * size_t(h);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        fb.at(x, y) = Vec3{planes[i], planes[n + i], planes[2 * n + i]};
+      }
+    }
+    return fb;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read EXR: " + e.what());
+  }
+}
+
+}  // namespace tracer
