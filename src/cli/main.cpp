@@ -41,7 +41,14 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
           {"load_ms", load_ms},
           {"build_ms", accel.build_ms},
           {"render_ms", render_ms},
-          {"rays", {{"primary", rays.primary}, {"shadow", rays.shadow}, {"ao", rays.ao}, {"total", rays.total()}}},
+          {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
+          {"max_depth", settings.max_depth},
+          {"rays",
+           {{"primary", rays.primary},
+            {"shadow", rays.shadow},
+            {"ao", rays.ao},
+            {"secondary", rays.secondary},
+            {"total", rays.total()}}},
           {"mrays_per_s", mrays},
           {"accel_bytes", accel.memory_bytes()},
           {"output", args.output}};
@@ -50,8 +57,12 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   const auto str = [&](const char* k) { return j[k].get<std::string>(); };
   std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
-  std::printf("image        %dx%d, %d AO rays per hit -> %s\n", j["width"].get<int>(), j["height"].get<int>(),
-              j["ao_samples"].get<int>(), str("output").c_str());
+  const std::string workload =
+      str("integrator") == "ao"
+          ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
+          : "whitted, at most " + std::to_string(j["max_depth"].get<int>()) + " reflections/refractions";
+  std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
+              str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
               !j["packets"].get<bool>()         ? ""
@@ -67,8 +78,9 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
   std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
   const auto& r = j["rays"];
-  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu total\n", r["primary"].get<unsigned long long>(),
-              r["shadow"].get<unsigned long long>(), r["ao"].get<unsigned long long>(),
+  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted, %llu total\n",
+              r["primary"].get<unsigned long long>(), r["shadow"].get<unsigned long long>(),
+              r["ao"].get<unsigned long long>(), r["secondary"].get<unsigned long long>(),
               r["total"].get<unsigned long long>());
   std::printf("throughput   %10.2f Mrays/s\n", j["mrays_per_s"].get<double>());
 }

@@ -36,6 +36,12 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--look,-l", a.look, "point the camera looks at, x,y,z");
   app.add_option("--up", a.up, "camera up vector x,y,z (default 0,1,0)");
   app.add_option("--fov", a.fov, "vertical field of view in degrees (default 53.13)");
+  app.add_option("--integrator", a.integrator,
+                 "what a pixel is made of: ao (the study's workload: direct light, ambient occlusion, every surface "
+                 "diffuse) or whitted (mirrors and glass from the MTL, hard shadows)")
+      ->capture_default_str();
+  app.add_option("--max-depth", s.max_depth, "whitted: reflections and refractions followed per path (0-64)")
+      ->capture_default_str();
   app.add_option("--ao", s.ao_samples, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
   app.add_option("--ao-distance", a.ao_distance, "maximum distance of AO rays (default: unbounded)");
   app.add_option("--ambient", s.ambient, "ambient light strength")->capture_default_str();
@@ -76,6 +82,7 @@ void validate(const RenderArgs& a) {
   check_range("--width", s.width, 1, 16384);
   check_range("--height", s.height, 1, 16384);
   check_range("--ao", s.ao_samples, 0, 4096);
+  check_range("--max-depth", s.max_depth, 0, 64);
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
   if (a.fov) check_range_real("--fov", *a.fov, 0.0, 179.0, true);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
@@ -100,6 +107,7 @@ void validate(const RenderArgs& a) {
   }
   sched_options_for(a);
   simd_target_for(a);
+  settings_for(a);
   exr_pixel_for(a);
 }
 
@@ -186,9 +194,12 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a) {
   RenderSettings s = a.settings;
   if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
-  // Packets by default where the accelerator has them, but not under --simd off (all scalar).
+  s.integrator = parse_name<Integrator>(kIntegratorNames, a.integrator, "--integrator", "integrator");
+  // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
+  // not for whitted, whose rays go one at a time.
   const bool by_default = s.packets && !a.no_packets && a.simd != "off";
-  s.packets = (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind);
+  s.packets =
+      (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
   return s;
 }
 

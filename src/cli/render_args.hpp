@@ -41,6 +41,7 @@ struct RenderArgs {
   std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
   std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
   std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};
+  std::string integrator{name_of<Integrator>(kIntegratorNames, RenderSettings{}.integrator)};
   std::string simd = "auto";
   std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
   std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};

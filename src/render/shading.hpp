@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <numbers>
 
+#include "base/enum_names.hpp"
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
 #include "math/rng.hpp"
@@ -18,8 +19,15 @@
 #include "render/framebuffer.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene.hpp"
+#include "shade/optics.hpp"
 
 namespace tracer {
+
+// What a pixel's radiance is made of: the study's workload (direct light from the lights'
+// centroids, ambient occlusion, every surface diffuse), or Whitted ray tracing (direct light
+// with hard shadows, perfect mirror reflection and dielectric refraction to max_depth).
+enum class Integrator { Ao, Whitted };
+inline constexpr EnumName<Integrator> kIntegratorNames[] = {{Integrator::Ao, "ao"}, {Integrator::Whitted, "whitted"}};
 
 struct RenderSettings {
   int width = 1024;
@@ -29,31 +37,35 @@ struct RenderSettings {
   float ambient = 0.25f;          // ambient light, times Kd and the unoccluded AO fraction
   float exposure = 1.5f;          // tone-mapping exposure
   uint32_t seed = 0;
+  Integrator integrator = Integrator::Ao;
+  int max_depth = 8;  // whitted: reflections and refractions followed per path
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
 };
 
 struct RayCounts {
-  uint64_t primary = 0, shadow = 0, ao = 0;
-  uint64_t total() const { return primary + shadow + ao; }
+  uint64_t primary = 0, shadow = 0, ao = 0, secondary = 0;  // secondary: reflected and refracted rays
+  uint64_t total() const { return primary + shadow + ao + secondary; }
   RayCounts& operator+=(const RayCounts& o) {
     primary += o.primary;
     shadow += o.shadow;
     ao += o.ao;
+    secondary += o.secondary;
     return *this;
   }
 };
 
 // Thread-safe accumulation of per-tile counts (one atomic add per tile, never per ray).
 struct AtomicRayCounts {
-  std::atomic<uint64_t> primary{0}, shadow{0}, ao{0};
+  std::atomic<uint64_t> primary{0}, shadow{0}, ao{0}, secondary{0};
   void add(const RayCounts& c) {
     primary.fetch_add(c.primary, std::memory_order_relaxed);
     shadow.fetch_add(c.shadow, std::memory_order_relaxed);
     ao.fetch_add(c.ao, std::memory_order_relaxed);
+    secondary.fetch_add(c.secondary, std::memory_order_relaxed);
   }
-  RayCounts load() const { return {primary.load(), shadow.load(), ao.load()}; }
+  RayCounts load() const { return {primary.load(), shadow.load(), ao.load(), secondary.load()}; }
 };
 
 // Everything one tile needs; shared read-only by all workers except the disjoint framebuffer pixels.
@@ -113,7 +125,7 @@ concept OcclusionPacketAccelerator = requires(const A& a, const RayPacket& p) {
 // A primary hit being shaded: the normal on the side the camera sees, the origin of the rays it
 // sends, and the colour so far.
 struct SurfacePoint {
-  Vec3 n, origin, albedo_over_pi, color;
+  Vec3 position, n, origin, albedo_over_pi, color;  // origin: position moved off the surface along n
   const Material* mat;
   uint32_t tri, geomID;
 };
@@ -127,6 +139,7 @@ inline SurfacePoint surface_point(const RenderContext& ctx, const Ray& primary, 
   if (dot(sp.n, primary.dir) > 0.0f) sp.n = -sp.n;  // shade the side the camera sees
   // Barycentric position: more precise than org + t*dir far from the camera.
   const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
+  sp.position = p;
   sp.origin = offset_origin(p, sp.n);
   sp.albedo_over_pi = sp.mat->kd * std::numbers::inv_pi_v<float>;
   sp.color = sp.mat->ke;
@@ -286,9 +299,71 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
   }
 }
 
+// Whitted ray tracing along `ray`, `depth` specular bounces from the camera: what the surface it
+// hits emits, plus its direct light and ambient term where diffuse, its mirror image where a
+// mirror, and where a dielectric the Fresnel-weighted reflected and (filtered by Tf) refracted
+// images, with total internal reflection; nothing past max_depth bounces or when nothing is hit.
+template <class Accel>
+Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& ray, int depth, RayCounts& counts) {
+  Hit hit;
+  if (!accel.intersect(ray, hit)) return Vec3{0.0f};
+  SurfacePoint sp = surface_point(ctx, ray, hit);  // sp.n faces the ray's side
+  const Material& mat = *sp.mat;
+  const bool deeper = depth < ctx.settings.max_depth;
+  switch (mat.surface()) {
+    case SurfaceKind::Mirror: {
+      if (!deeper) return sp.color;
+      Ray reflected;
+      reflected.org = sp.origin;
+      reflected.dir = reflect(ray.dir, sp.n);
+      ++counts.secondary;
+      return sp.color + mat.ks * whitted_radiance(accel, ctx, reflected, depth + 1, counts);
+    }
+    case SurfaceKind::Dielectric: {
+      if (!deeper) return sp.color;
+      const bool entering = dot(normalize(ctx.scene->triangles[hit.tri].normal()), ray.dir) < 0.0f;
+      const float eta_i = entering ? 1.0f : mat.ni, eta_t = entering ? mat.ni : 1.0f;
+      const float f = fresnel_dielectric(-dot(ray.dir, sp.n), eta_i, eta_t);
+      Ray reflected;
+      reflected.org = sp.origin;
+      reflected.dir = reflect(ray.dir, sp.n);
+      ++counts.secondary;
+      Vec3 color = sp.color + whitted_radiance(accel, ctx, reflected, depth + 1, counts) * f;
+      Vec3 transmitted;
+      if (f < 1.0f && refract(ray.dir, sp.n, eta_i / eta_t, transmitted)) {
+        Ray refracted;
+        refracted.org = offset_origin(sp.position, -sp.n);  // off the surface, on the far side
+        refracted.dir = transmitted;
+        ++counts.secondary;
+        color += mat.tf * whitted_radiance(accel, ctx, refracted, depth + 1, counts) * (1.0f - f);
+      }
+      return color;
+    }
+    case SurfaceKind::Diffuse:
+      break;
+  }
+  for (const Light& light : ctx.scene->lights) {
+    Ray shadow;
+    Vec3 contribution;
+    if (!light_sample(sp, light, shadow, contribution)) continue;
+    ++counts.shadow;
+    if (!occluded_leaving(accel, shadow, sp.tri)) sp.color += contribution;
+  }
+  return sp.color + mat.kd * ctx.settings.ambient;
+}
+
 template <class Accel>
 RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile) {
   RayCounts counts;
+  if (ctx.settings.integrator == Integrator::Whitted) {
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        ++counts.primary;
+        ctx.framebuffer->at(x, y) = whitted_radiance(accel, ctx, ctx.camera.primary_ray(x, y), 0, counts);
+      }
+    }
+    return counts;
+  }
   if constexpr (PacketAccelerator<Accel>) {
     if (ctx.settings.packets) {
       for (int by = tile.y0; by < tile.y1; by += kPacketEdge) {

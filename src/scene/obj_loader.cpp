@@ -232,9 +232,10 @@ Material to_material(const tinyobj::material_t& m, const std::string& name) {
   mat.kd = {float(m.diffuse[0]), float(m.diffuse[1]), float(m.diffuse[2])};
   mat.ks = {float(m.specular[0]), float(m.specular[1]), float(m.specular[2])};
   mat.ke = {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])};
+  mat.tf = {float(m.transmittance[0]), float(m.transmittance[1]), float(m.transmittance[2])};
   mat.ni = float(m.ior);
   mat.illum = m.illum;
-  if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !std::isfinite(mat.ni)) {
+  if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !is_finite(mat.tf) || !std::isfinite(mat.ni)) {
     throw InputError(name + ": material " + in_quotes(m.name) + " has a non-finite colour or index");
   }
   return mat;

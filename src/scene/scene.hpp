@@ -30,16 +30,28 @@ struct Triangle {
   bool degenerate() const;
 };
 
-// OBJ material. The study's workload shades with Kd and Ke only; Ks, Ni and illum are read and
-// kept with the material.
+// How a material scatters light in the integrators that follow specular paths (whitted): the
+// study's ao workload shades every surface as diffuse.
+enum class SurfaceKind { Diffuse, Mirror, Dielectric };
+
+// OBJ material: Kd diffuse, Ks specular, Ke emission, Ni index of refraction, Tf transmission
+// filter, illum the MTL illumination model.
 struct Material {
   std::string name = "default";
   Vec3 kd{0.7f};
   Vec3 ks{0.0f};
   Vec3 ke{0.0f};
+  Vec3 tf{1.0f};
   float ni = 1.0f;
   int illum = 2;
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
+  // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
+  // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.
+  SurfaceKind surface() const {
+    if (illum == 3 || illum == 5) return SurfaceKind::Mirror;
+    if ((illum == 4 || illum == 6 || illum == 7 || illum == 9) && ni > 0.0f) return SurfaceKind::Dielectric;
+    return SurfaceKind::Diffuse;
+  }
 };
 
 // An area light is approximated by its area-weighted centroid (one shadow ray per light, as in the
