@@ -215,12 +215,9 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
   return sp.color + sp.mat->kd * (s.ambient * unoccluded);
 }
 
-// The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
+// Adds to sp.color what every light gives it, one shadow ray per light, in the lights' order.
 template <class Accel>
-Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
-               RayCounts& counts) {
-  if (!hit.valid()) return Vec3{0.0f};
-  SurfacePoint sp = surface_point(ctx, primary, hit);
+void add_direct_light(const Accel& accel, const RenderContext& ctx, SurfacePoint& sp, RayCounts& counts) {
   for (const Light& light : ctx.scene->lights) {
     Ray shadow;
     Vec3 contribution;
@@ -228,6 +225,15 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
     ++counts.shadow;
     if (!occluded_leaving(accel, shadow, sp.tri)) sp.color += contribution;
   }
+}
+
+// The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
+template <class Accel>
+Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
+               RayCounts& counts) {
+  if (!hit.valid()) return Vec3{0.0f};
+  SurfacePoint sp = surface_point(ctx, primary, hit);
+  add_direct_light(accel, ctx, sp, counts);
   return finish_with_ambient(accel, ctx, x, y, sp, counts);
 }
 
@@ -342,13 +348,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
     case SurfaceKind::Diffuse:
       break;
   }
-  for (const Light& light : ctx.scene->lights) {
-    Ray shadow;
-    Vec3 contribution;
-    if (!light_sample(sp, light, shadow, contribution)) continue;
-    ++counts.shadow;
-    if (!occluded_leaving(accel, shadow, sp.tri)) sp.color += contribution;
-  }
+  add_direct_light(accel, ctx, sp, counts);
   return sp.color + mat.kd * ctx.settings.ambient;
 }
 
