@@ -71,6 +71,17 @@ TEST(Loader, PolygonsNegativeIndicesAndCrlf) {
   EXPECT_EQ(s.triangles[0].v0, (Vec3{0, 0, 0}));
 }
 
+TEST(Loader, VertexNormalsAreKeptPerCorner) {
+  // Two triangles, one with normals (given out of order) and one without: zero where none.
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 1 0\nf 1//2 2//1 3//1\nf 1 2 3\n";
+  const Scene s = load_obj_from_string(obj, "", "normals.obj");
+  ASSERT_EQ(s.corner_normals.size(), 6u);
+  EXPECT_EQ(s.corner_normals[0], (Vec3{0, 1, 0}));
+  EXPECT_EQ(s.corner_normals[1], (Vec3{0, 0, 1}));
+  EXPECT_EQ(s.corner_normals[5], (Vec3{0.0f}));
+  EXPECT_TRUE(load_obj_from_string("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "", "none.obj").corner_normals.empty());
+}
+
 TEST(Loader, GroupsBecomeGeometries) {
   const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 2 3\nf 3 2 1\n";
   const Scene s = load_obj_from_string(obj, "", "groups.obj");

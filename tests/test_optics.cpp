@@ -128,5 +128,32 @@ TEST(Whitted, MirrorShowsWhatItFacesWeightedByKs) {
   EXPECT_NEAR(l.z, 0.2f, 1e-6f);
 }
 
+TEST(Whitted, VertexNormalsShadeDiffuseSurfaces) {
+  // A diffuse quad lit by a point light on its axis (at the camera): with vertex normals tilted
+  // 60 degrees from the face, the lit radiance is cos 60 = 1/2 of that with normals along it.
+  const auto radiance = [](Vec3 vn) {
+    Scene s;
+    Material white;
+    white.kd = Vec3{1.0f};
+    s.materials = {white};
+    add_quad(s, 0.0f, 2.0f, 0);
+    s.corner_normals.assign(6, vn);
+    s.finalize();
+    Light light;
+    light.position = Vec3{0, 0, 5};
+    light.power = Vec3{25.0f};
+    s.lights = {light};
+    return centre_radiance(s);
+  };
+  const float c = std::cos(60.0f * std::numbers::pi_v<float> / 180.0f),
+              sn = std::sin(60.0f * std::numbers::pi_v<float> / 180.0f);
+  const Vec3 straight = radiance(Vec3{0, 0, 1});
+  const Vec3 tilted = radiance(Vec3{0, sn, c});
+  EXPECT_NEAR(straight.x, std::numbers::inv_pi_v<float>, 1e-4f);  // kd/pi * I cos / d^2, I = d^2
+  EXPECT_NEAR(tilted.x / straight.x, c, 1e-4f);
+  // Vertex normals pointing away from the camera side are turned to it, not shading as black.
+  EXPECT_NEAR(radiance(Vec3{0, 0, -1}).x, straight.x, 1e-6f);
+}
+
 }  // namespace
 }  // namespace tracer

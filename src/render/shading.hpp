@@ -126,6 +126,7 @@ concept OcclusionPacketAccelerator = requires(const A& a, const RayPacket& p) {
 // sends, and the colour so far.
 struct SurfacePoint {
   Vec3 position, n, origin, albedo_over_pi, color;  // origin: position moved off the surface along n
+  Vec3 shading_n;  // the normal shading uses: n, or the interpolated vertex normal on n's side
   const Material* mat;
   uint32_t tri, geomID;
 };
@@ -140,6 +141,7 @@ inline SurfacePoint surface_point(const RenderContext& ctx, const Ray& primary, 
   // Barycentric position: more precise than org + t*dir far from the camera.
   const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
   sp.position = p;
+  sp.shading_n = sp.n;
   sp.origin = offset_origin(p, sp.n);
   sp.albedo_over_pi = sp.mat->kd * std::numbers::inv_pi_v<float>;
   sp.color = sp.mat->ke;
@@ -157,7 +159,8 @@ inline bool light_sample(const SurfacePoint& sp, const Light& light, Ray& shadow
   if (!(d2 > 0.0f)) return false;
   const float d = std::sqrt(d2);
   const Vec3 wi = to_light / d;
-  const float cos_surface = dot(sp.n, wi);
+  if (dot(sp.n, wi) <= 0.0f) return false;  // below the surface itself, whatever the shading normal
+  const float cos_surface = dot(sp.shading_n, wi);
   if (cos_surface <= 0.0f) return false;
   // Irradiance from a light of area A at distance d: power * cos_l / (d^2 + A/pi), exact on the
   // axis of a disk of that area and free of the 1/d^2 blow-up near the lamp; 1/d^2 for points.
@@ -305,6 +308,18 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
   }
 }
 
+// The vertex normals of the hit triangle interpolated at the hit, turned to the side of the
+// geometric normal `n` (which faces the ray); `n` itself where the scene has none.
+inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
+  if (scene.corner_normals.empty()) return n;
+  const Vec3* c = &scene.corner_normals[3 * size_t(hit.tri)];
+  const Vec3 s = c[0] * (1.0f - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
+  const float len = length(s);
+  if (!(len > 0.0f) || !std::isfinite(len)) return n;
+  const Vec3 unit = s / len;
+  return dot(unit, n) < 0.0f ? -unit : unit;
+}
+
 // Whitted ray tracing along `ray`, `depth` specular bounces from the camera: what the surface it
 // hits emits, plus its direct light and ambient term where diffuse, its mirror image where a
 // mirror, and where a dielectric the Fresnel-weighted reflected and (filtered by Tf) refracted
@@ -314,6 +329,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   Hit hit;
   if (!accel.intersect(ray, hit)) return Vec3{0.0f};
   SurfacePoint sp = surface_point(ctx, ray, hit);  // sp.n faces the ray's side
+  sp.shading_n = interpolated_normal(*ctx.scene, hit, sp.n);
   const Material& mat = *sp.mat;
   const bool deeper = depth < ctx.settings.max_depth;
   switch (mat.surface()) {
@@ -321,7 +337,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
       if (!deeper) return sp.color;
       Ray reflected;
       reflected.org = sp.origin;
-      reflected.dir = reflect(ray.dir, sp.n);
+      reflected.dir = reflect(ray.dir, sp.shading_n);
       ++counts.secondary;
       return sp.color + mat.ks * whitted_radiance(accel, ctx, reflected, depth + 1, counts);
     }
@@ -329,14 +345,14 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
       if (!deeper) return sp.color;
       const bool entering = dot(normalize(ctx.scene->triangles[hit.tri].normal()), ray.dir) < 0.0f;
       const float eta_i = entering ? 1.0f : mat.ni, eta_t = entering ? mat.ni : 1.0f;
-      const float f = fresnel_dielectric(-dot(ray.dir, sp.n), eta_i, eta_t);
+      const float f = fresnel_dielectric(-dot(ray.dir, sp.shading_n), eta_i, eta_t);
       Ray reflected;
       reflected.org = sp.origin;
-      reflected.dir = reflect(ray.dir, sp.n);
+      reflected.dir = reflect(ray.dir, sp.shading_n);
       ++counts.secondary;
       Vec3 color = sp.color + whitted_radiance(accel, ctx, reflected, depth + 1, counts) * f;
       Vec3 transmitted;
-      if (f < 1.0f && refract(ray.dir, sp.n, eta_i / eta_t, transmitted)) {
+      if (f < 1.0f && refract(ray.dir, sp.shading_n, eta_i / eta_t, transmitted)) {
         Ray refracted;
         refracted.org = offset_origin(sp.position, -sp.n);  // off the surface, on the far side
         refracted.dir = transmitted;

@@ -309,6 +309,9 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   bool used_default = false;
 
   size_t faces_seen = 0;
+  const size_t normal_count = attrib.normals.size() / 3;
+  bool any_normal = false;
+  std::vector<Vec3> corner_normals;
   for (const tinyobj::shape_t& shape : parsed.shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     Geometry g;
@@ -328,6 +331,17 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
           if (vi >= scene.vertex_count)
             throw InputError(name + ": face " + std::to_string(faces_seen) + " has a vertex index out of range");
           p[k] = {attrib.vertices[3 * vi], attrib.vertices[3 * vi + 1], attrib.vertices[3 * vi + 2]};
+          const int ni = mesh.indices[offset + k].normal_index;
+          Vec3 normal{0.0f};
+          if (ni >= 0) {
+            if (size_t(ni) >= normal_count)
+              throw InputError(name + ": face " + std::to_string(faces_seen) + " has a normal index out of range");
+            normal = {attrib.normals[3 * size_t(ni)], attrib.normals[3 * size_t(ni) + 1],
+                      attrib.normals[3 * size_t(ni) + 2]};
+            if (!is_finite(normal)) throw InputError(name + ": normal " + std::to_string(ni + 1) + " is not finite");
+            any_normal = true;
+          }
+          corner_normals.push_back(normal);
         }
         const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
         uint32_t material = default_material;
@@ -348,6 +362,7 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   }
   if (used_default) scene.materials.push_back(Material{});
   if (scene.triangles.empty()) throw InputError(name + ": scene has no triangles");
+  if (any_normal) scene.corner_normals = std::move(corner_normals);
   scene.finalize();
   return scene;
 }

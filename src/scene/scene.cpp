@@ -27,6 +27,7 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
     tri_material.push_back(material);
   }
   vertex_count += vertices.size();
+  if (!corner_normals.empty()) corner_normals.resize(3 * triangles.size(), Vec3{0.0f});  // none for this mesh
   geometries.push_back(std::move(g));
 }
 

@@ -83,6 +83,10 @@ struct Scene {
   std::vector<uint32_t> tri_geom;      // geomID per triangle
   std::vector<uint32_t> tri_prim;      // primID per triangle
   std::vector<uint32_t> tri_material;  // index into materials
+  // Shading normals from the file's `vn`, three per triangle (corner order), or empty when it has
+  // none; zero at the corners of faces that give none. The ao workload shades with the geometric
+  // normal; whitted interpolates these.
+  std::vector<Vec3> corner_normals;
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
   std::vector<Light> lights;
