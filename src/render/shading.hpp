@@ -127,6 +127,7 @@ concept OcclusionPacketAccelerator = requires(const A& a, const RayPacket& p) {
 struct SurfacePoint {
   Vec3 position, n, origin, albedo_over_pi, color;  // origin: position moved off the surface along n
   Vec3 shading_n;  // the normal shading uses: n, or the interpolated vertex normal on n's side
+  bool front;      // the ray hit the side the triangle's winding faces
   const Material* mat;
   uint32_t tri, geomID;
 };
@@ -137,7 +138,8 @@ inline SurfacePoint surface_point(const RenderContext& ctx, const Ray& primary, 
   SurfacePoint sp;
   sp.mat = &scene.materials[scene.tri_material[hit.tri]];
   sp.n = normalize(tri.normal());
-  if (dot(sp.n, primary.dir) > 0.0f) sp.n = -sp.n;  // shade the side the camera sees
+  sp.front = dot(sp.n, primary.dir) <= 0.0f;
+  if (!sp.front) sp.n = -sp.n;  // shade the side the camera sees
   // Barycentric position: more precise than org + t*dir far from the camera.
   const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
   sp.position = p;
@@ -343,8 +345,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
     }
     case SurfaceKind::Dielectric: {
       if (!deeper) return sp.color;
-      const bool entering = dot(normalize(ctx.scene->triangles[hit.tri].normal()), ray.dir) < 0.0f;
-      const float eta_i = entering ? 1.0f : mat.ni, eta_t = entering ? mat.ni : 1.0f;
+      const float eta_i = sp.front ? 1.0f : mat.ni, eta_t = sp.front ? mat.ni : 1.0f;  // front: entering
       const float f = fresnel_dielectric(-dot(ray.dir, sp.shading_n), eta_i, eta_t);
       Ray reflected;
       reflected.org = sp.origin;
