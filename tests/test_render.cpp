@@ -90,32 +90,34 @@ TEST(Render, SameRenderTwiceIsByteIdentical) {
   EXPECT_NE(a.rgb, c.rgb);
 }
 
+// Renders `scene` (empty: the built-in box) at 96x96 with `flags` and requires the bytes of
+// tests/golden/`golden`.png; the PSNR is printed on failure.
+void expect_golden(const std::string& scene, const std::string& flags, const std::string& golden) {
+  SCOPED_TRACE(golden);
+  const std::string dir = test::temp_dir();
+  const std::string out = dir + "/" + golden + ".png";
+  const auto r = test::run_tracer("render " + scene + " " + flags + " -q --width 96 --height 96 -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Image8 expected = read_image(std::string(TRACER_GOLDEN_DIR) + "/" + golden + ".png");
+  const Image8 got = read_image(out);
+  EXPECT_EQ(expected.rgb, got.rgb) << "PSNR " << test::psnr(expected, got) << " dB";
+  std::filesystem::remove_all(dir);
+}
+
+std::string cornell(const std::string& name) { return test::scene_path("cornell-box/CornellBox-" + name + ".obj"); }
+
 // Golden images: 96x96, default settings (16 AO rays), made with
 //   tracer render ../shared/scenes/cornell-box/CornellBox-X.obj --width 96 --height 96
 //     --accel brute --sched seq -o tests/golden/X.png
 // (and with no scene for builtin.png), then looked at. The test renders through the default
-// path (SAH BVH, oneTBB) and requires the same bytes: every accelerator, SIMD target, scheduler
-// and thread count computes the same floats (tested elsewhere), so the study's workload is
-// byte-identical to its golden images. The tolerance is zero; only a different libm (another
-// platform's exp/pow/sin) could move a pixel, and then PSNR says how far (printed on failure).
+// path and requires the same bytes: every accelerator, SIMD target, scheduler and thread count
+// computes the same floats (tested elsewhere), so the study's workload is byte-identical to its
+// golden images. The tolerance is zero; only a different libm (another platform's exp/pow/sin)
+// could move a pixel, and then PSNR says how far.
 TEST(Render, GoldenImages) {
-  const std::string dir = test::temp_dir();
-  std::vector<std::pair<std::string, std::string>> scenes = {{"builtin", ""}};
-  if (test::have_shared_scenes()) {
-    for (const char* name : {"Original", "Mirror", "Sphere", "Water"}) {
-      scenes.emplace_back(name, test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj"));
-    }
-  }
-  for (const auto& [name, path] : scenes) {
-    SCOPED_TRACE(name);
-    const std::string out = dir + "/" + name + ".png";
-    const auto r = test::run_tracer("render " + path + " -q --width 96 --height 96 -o " + out);
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-    const Image8 golden = read_image(std::string(TRACER_GOLDEN_DIR) + "/" + name + ".png");
-    const Image8 got = read_image(out);
-    EXPECT_EQ(golden.rgb, got.rgb) << "PSNR " << test::psnr(golden, got) << " dB";
-  }
-  std::filesystem::remove_all(dir);
+  expect_golden("", "", "builtin");
+  if (!test::have_shared_scenes()) return;
+  for (const char* name : {"Original", "Mirror", "Sphere", "Water"}) expect_golden(cornell(name), "", name);
 }
 
 // Whitted reference images: 96x96, made with
@@ -123,22 +125,12 @@ TEST(Render, GoldenImages) {
 //     --height 96 -o tests/golden/whitted-X.png
 // and looked at (the mirror block and spheres reflect the walls; the glass, Tf 0.1, is dark).
 // Rendered here through the scalar BVH one ray at a time on one thread, against images made
-// with the default 8-wide BVH on all threads: the same bytes (tolerance zero, PSNR on failure).
+// with the default 8-wide BVH on all threads: the same bytes.
 TEST(Render, WhittedGoldenImages) {
   if (!test::have_shared_scenes()) GTEST_SKIP() << "no ../shared/scenes";
-  const std::string dir = test::temp_dir();
   for (const char* name : {"Mirror", "Sphere", "Water"}) {
-    SCOPED_TRACE(name);
-    const std::string out = dir + "/" + name + ".png";
-    const auto r =
-        test::run_tracer("render " + test::scene_path(std::string("cornell-box/CornellBox-") + name + ".obj") +
-                         " --integrator whitted --accel bvh --sched seq -q --width 96 --height 96 -o " + out);
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-    const Image8 golden = read_image(std::string(TRACER_GOLDEN_DIR) + "/whitted-" + name + ".png");
-    const Image8 got = read_image(out);
-    EXPECT_EQ(golden.rgb, got.rgb) << "PSNR " << test::psnr(golden, got) << " dB";
+    expect_golden(cornell(name), "--integrator whitted --accel bvh --sched seq", std::string("whitted-") + name);
   }
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Exr, LinearRadianceRoundTripsAsFloatAndAsHalf) {
