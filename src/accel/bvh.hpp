@@ -162,7 +162,9 @@ class Bvh {
 struct RayBoxTest {
   // Boxes are also kept when entered up to ~16 ulps beyond tfar: a box's entry distance and a
   // triangle's t round differently, and a triangle hit at exactly the current closest t must
-  // still be reached so ties resolve the same way as in brute force.
+  // still be reached so ties resolve the same way as in brute force. The guard is relative: a
+  // triangle t whose rounding is larger (t small beside its vertices' distances, hit near an
+  // edge) can still fall below its box's entry; the README states what then differs.
   static constexpr float kTieGuard = 1.0f + 0x1p-20f;
   static constexpr float kFarGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
   float org[3], inv[3], inv_far[3];
