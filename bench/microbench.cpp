@@ -13,7 +13,7 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"

@@ -8,7 +8,7 @@
 #include <mutex>
 
 #include "accel/accelerator.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
 #include "test_util.hpp"

@@ -82,7 +82,7 @@ Vec3 centre_radiance(const Scene& scene) {
   RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
   RenderControl control;
   EXPECT_TRUE(render_image(build_accelerator(scene, AccelOptions{}), ctx, SchedOptions{}, control));
-  return fb.at(4, 4);
+  return fb.radiance(4, 4);
 }
 
 TEST(Whitted, GlassSlabTransmitsWhatFresnelLeaves) {

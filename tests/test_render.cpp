@@ -8,7 +8,7 @@
 #include "accel/accelerator.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "test_util.hpp"
 
@@ -50,8 +50,8 @@ TEST(Render, LitQuadMatchesLambert) {
       const Vec3 to = light - p;
       const float d2 = dot(to, to);
       const float expected = 0.5f / std::numbers::pi_v<float> * 3.0f * (to.z / std::sqrt(d2)) / d2;
-      EXPECT_NEAR(fb.at(x, y).x, expected, 2e-3f * expected) << x << "," << y << " got " << fb.at(x, y).x;
-      EXPECT_FLOAT_EQ(fb.at(x, y).x, fb.at(x, y).z);
+      EXPECT_NEAR(fb.radiance(x, y).x, expected, 2e-3f * expected) << x << "," << y << " got " << fb.radiance(x, y).x;
+      EXPECT_FLOAT_EQ(fb.radiance(x, y).x, fb.radiance(x, y).z);
       ++checked;
     }
   }
@@ -72,7 +72,7 @@ TEST(Render, ShadowedPointIsAmbientOnly) {
   const Camera camera(cam, s.width, s.height);
   const Framebuffer fb = render(scene, cam, s);
   // Find the pixel whose primary ray hits the quad nearest (0,0,0) and is not the blocker itself.
-  const Vec3 c = fb.at(16, 16);
+  const Vec3 c = fb.radiance(16, 16);
   const Ray r = camera.primary_ray(16, 16);
   ASSERT_NEAR(-r.org.z / r.dir.z * r.dir.x + r.org.x, 0.0f, 0.1f);
   EXPECT_NEAR(c.x, 0.7f * 0.25f, 1e-6f);  // default Kd 0.7 times ambient
@@ -142,7 +142,7 @@ TEST(Exr, LinearRadianceRoundTripsAsFloatAndAsHalf) {
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 5; ++x) {
       const float v = values[y * 5 + x];
-      fb.at(x, y) = Vec3{v, 2.0f * v, 0.5f * v};
+      fb.set(x, y, Vec3{v, 2.0f * v, 0.5f * v});
     }
   const std::string dir = test::temp_dir();
   for (const ExrPixel pixel : {ExrPixel::Float, ExrPixel::Half}) {
@@ -154,7 +154,7 @@ TEST(Exr, LinearRadianceRoundTripsAsFloatAndAsHalf) {
     const float tolerance = pixel == ExrPixel::Float ? 0.0f : 1.0f / 2048.0f;  // half: 11 significant bits
     for (int y = 0; y < 3; ++y)
       for (int x = 0; x < 5; ++x) {
-        const Vec3 a = fb.at(x, y), b = back.at(x, y);
+        const Vec3 a = fb.radiance(x, y), b = back.radiance(x, y);
         for (int c = 0; c < 3; ++c)
           EXPECT_LE(std::fabs(a[c] - b[c]), tolerance * std::fabs(a[c]) + 1e-7f) << x << "," << y;
       }

@@ -7,7 +7,7 @@
 
 #include "accel/accelerator.hpp"
 #include "render/render_image.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
 #include "test_util.hpp"

@@ -7,7 +7,7 @@
 #include <functional>
 #include <random>
 
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 
 #include "accel/accelerator.hpp"
 #include "scene/builtin.hpp"

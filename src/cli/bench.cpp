@@ -24,7 +24,7 @@
 #include "cli/parse.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"

@@ -8,7 +8,7 @@
 
 #include <string>
 #include <vector>
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 
 namespace tracer::cli {
 

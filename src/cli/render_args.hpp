@@ -11,7 +11,7 @@
 #include "accel/accelerator.hpp"
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer::cli {

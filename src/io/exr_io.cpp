@@ -54,7 +54,7 @@ std::vector<T> planar(const Framebuffer& fb) {
   std::vector<T> planes(3 * n);
   for (int y = 0; y < fb.height(); ++y) {
     for (int x = 0; x < fb.width(); ++x) {
-      const Vec3& p = fb.at(x, y);
+      const Vec3 p = fb.radiance(x, y);
       const size_t i = size_t(y) * size_t(fb.width()) + size_t(x);
       planes[i] = T(p.x);
       planes[n + i] = T(p.y);
@@ -112,7 +112,7 @@ Framebuffer read_exr(const std::string& path) {
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const size_t i = size_t(y) * size_t(w) + size_t(x);
-        fb.at(x, y) = Vec3{planes[i], planes[n + i], planes[2 * n + i]};
+        fb.set(x, y, Vec3{planes[i], planes[n + i], planes[2 * n + i]});
       }
     }
     return fb;

@@ -16,6 +16,12 @@ uint8_t encode(float linear, float exposure) {
 
 }  // namespace
 
+uint32_t Framebuffer::min_samples() const {
+  uint32_t m = UINT32_MAX;
+  for (uint32_t n : samples_) m = std::min(m, n);
+  return samples_.empty() ? 0u : m;
+}
+
 Image8 tonemap(const Framebuffer& fb, float exposure) {
   Image8 img;
   img.width = fb.width();
@@ -24,7 +30,7 @@ Image8 tonemap(const Framebuffer& fb, float exposure) {
   size_t k = 0;
   for (int y = 0; y < fb.height(); ++y) {
     for (int x = 0; x < fb.width(); ++x) {
-      const Vec3 c = fb.at(x, y);
+      const Vec3 c = fb.radiance(x, y);
       img.rgb[k++] = encode(c.x, exposure);
       img.rgb[k++] = encode(c.y, exposure);
       img.rgb[k++] = encode(c.z, exposure);

@@ -1,4 +1,7 @@
-// Linear-radiance framebuffer and the conversion to display-ready 8-bit sRGB.
+// Linear-radiance framebuffer: per pixel the sum of the samples taken so far and their count, so
+// passes add up (progressive renders, ranks of an MPI job) and any prefix of them is an image.
+// Each pixel's samples are added in sample order, so the sums are the same however the passes,
+// tiles and threads were cut.
 #pragma once
 
 #include <cstdint>
@@ -10,15 +13,43 @@ namespace tracer {
 
 class Framebuffer {
  public:
-  Framebuffer(int width, int height) : width_(width), height_(height), pixels_(size_t(width) * size_t(height)) {}
+  Framebuffer(int width, int height)
+      : width_(width), height_(height), sum_(size_t(width) * size_t(height)), samples_(sum_.size(), 0u) {}
   int width() const { return width_; }
   int height() const { return height_; }
-  Vec3& at(int x, int y) { return pixels_[size_t(y) * size_t(width_) + size_t(x)]; }
-  const Vec3& at(int x, int y) const { return pixels_[size_t(y) * size_t(width_) + size_t(x)]; }
+  size_t pixel_count() const { return sum_.size(); }
+
+  // Adds one sample to pixel (x, y).
+  void add(int x, int y, Vec3 sample) {
+    const size_t i = index(x, y);
+    sum_[i] += sample;
+    ++samples_[i];
+  }
+  // Makes (x, y) hold exactly `value`, as one sample (an image read back, a test's pattern).
+  void set(int x, int y, Vec3 value) {
+    const size_t i = index(x, y);
+    sum_[i] = value;
+    samples_[i] = 1;
+  }
+  // The pixel's estimate: the mean of its samples, black before the first.
+  Vec3 radiance(int x, int y) const {
+    const size_t i = index(x, y);
+    return samples_[i] == 0 ? Vec3{0.0f} : sum_[i] / float(samples_[i]);
+  }
+  uint32_t samples(int x, int y) const { return samples_[index(x, y)]; }
+  // Fewest samples of any pixel: 0 while some pixel has none.
+  uint32_t min_samples() const;
+  // Raw access by pixel index (row-major), for moving whole images (gathering ranks' passes).
+  Vec3* sums() { return sum_.data(); }
+  const Vec3* sums() const { return sum_.data(); }
+  uint32_t* sample_counts() { return samples_.data(); }
+  const uint32_t* sample_counts() const { return samples_.data(); }
 
  private:
+  size_t index(int x, int y) const { return size_t(y) * size_t(width_) + size_t(x); }
   int width_, height_;
-  std::vector<Vec3> pixels_;
+  std::vector<Vec3> sum_;
+  std::vector<uint32_t> samples_;
 };
 
 // 8-bit RGB, rows top to bottom.
@@ -27,7 +58,8 @@ struct Image8 {
   std::vector<uint8_t> rgb;
 };
 
-// Exponential tone map 1 - exp(-exposure * L), then the sRGB transfer curve, rounded to 8 bits.
+// Exponential tone map 1 - exp(-exposure * L) of each pixel's radiance, then the sRGB transfer
+// curve, rounded to 8 bits.
 Image8 tonemap(const Framebuffer& fb, float exposure);
 
 }  // namespace tracer

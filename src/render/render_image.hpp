@@ -10,7 +10,7 @@
 #include "accel/accelerator.hpp"
 #include "base/errors.hpp"
 #include "parallel/parallel_for_tiles.hpp"
-#include "render/shading.hpp"
+#include "render/render_tile.hpp"
 
 namespace tracer {
 
