@@ -234,8 +234,10 @@ Material to_material(const tinyobj::material_t& m, const std::string& name) {
   mat.ke = {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])};
   mat.tf = {float(m.transmittance[0]), float(m.transmittance[1]), float(m.transmittance[2])};
   mat.ni = float(m.ior);
+  mat.ns = float(m.shininess);
   mat.illum = m.illum;
-  if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !is_finite(mat.tf) || !std::isfinite(mat.ni)) {
+  if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !is_finite(mat.tf) || !std::isfinite(mat.ni) ||
+      !std::isfinite(mat.ns)) {
     throw InputError(name + ": material " + in_quotes(m.name) + " has a non-finite colour or index");
   }
   return mat;

@@ -34,14 +34,15 @@ struct Triangle {
 // study's ao workload shades every surface as diffuse.
 enum class SurfaceKind { Diffuse, Mirror, Dielectric };
 
-// OBJ material: Kd diffuse, Ks specular, Ke emission, Ni index of refraction, Tf transmission
-// filter, illum the MTL illumination model.
+// OBJ material: Kd diffuse, Ks specular, Ns specular exponent, Ke emission, Ni index of
+// refraction, Tf transmission filter, illum the MTL illumination model.
 struct Material {
   std::string name = "default";
   Vec3 kd{0.7f};
   Vec3 ks{0.0f};
   Vec3 ke{0.0f};
   Vec3 tf{1.0f};
+  float ns = 0.0f;
   float ni = 1.0f;
   int illum = 2;
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }

@@ -1,0 +1,261 @@
+// Each BSDF lobe on its own: energy (white furnace), sampling against evaluation (the pdf of the
+// sampled directions, a chi-square test in the style of pbrt-v4's), and the delta lobes against
+// Fresnel and Snell.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "shade/bsdf.hpp"
+#include "shade/material_bsdf.hpp"
+
+namespace tracer {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+Vec3 direction(float theta_deg, float phi_deg = 0.0f) {
+  const float t = theta_deg * kPi / 180.0f, p = phi_deg * kPi / 180.0f;
+  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+}
+
+struct Lobe {
+  std::string name;
+  Bsdf bsdf;
+};
+
+// Non-delta BSDFs under a tilted shading frame, so the frame code is part of what is tested.
+std::vector<Lobe> smooth_lobes() {
+  const Frame frame(normalize(Vec3{0.2f, 0.3f, 1.0f}));
+  std::vector<Lobe> v;
+  v.push_back({"lambert", Bsdf::smooth(frame, Vec3{1.0f}, Vec3{0.0f}, Ggx{1.0f})});
+  for (const float ns : {1.0f, 10.0f, 50.0f, 256.0f}) {
+    v.push_back({"ggx Ns " + std::to_string(int(ns)),
+                 Bsdf::smooth(frame, Vec3{0.0f}, Vec3{1.0f}, Ggx::from_phong_exponent(ns))});
+  }
+  v.push_back({"lambert + ggx", Bsdf::smooth(frame, Vec3{0.5f}, Vec3{0.5f}, Ggx::from_phong_exponent(20.0f))});
+  return v;
+}
+
+Vec3 world_wo(float theta_deg) {
+  const Frame frame(normalize(Vec3{0.2f, 0.3f, 1.0f}));
+  return frame.to_world(direction(theta_deg, 30.0f));
+}
+
+TEST(Bsdf, WhiteFurnaceNoLobeReturnsMoreThanItReceives) {
+  // The mean sample weight is the lobe's albedo for light arriving along wo; it must not exceed 1
+  // (within 1 %), and a white Lambert lobe reflects exactly 1.
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const Lobe& lobe : smooth_lobes()) {
+    for (const float theta : {0.0f, 30.0f, 60.0f, 85.0f}) {
+      const Vec3 wo = world_wo(theta);
+      const int n = 200000;
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) {
+        BsdfSample s;
+        if (lobe.bsdf.sample(wo, u(gen), u(gen), u(gen), s)) sum += s.weight.x;
+      }
+      const double albedo = sum / n;
+      EXPECT_LE(albedo, 1.01) << lobe.name << " at " << theta;
+      if (lobe.name == "lambert") {
+        EXPECT_NEAR(albedo, 1.0, 1e-3) << theta;
+      }
+      // A narrow GGX lobe loses little to masking away from grazing angles (a rough one more:
+      // single scattering has no multiple-bounce term).
+      if (lobe.name == "ggx Ns 256" && theta <= 60.0f) {
+        EXPECT_GT(albedo, 0.93) << theta;
+      }
+    }
+  }
+}
+
+TEST(Bsdf, SamplingAgreesWithEvaluation) {
+  // Two estimates of the albedo: the mean weight of sampled directions, and eval() integrated
+  // by uniform hemisphere sampling; and the pdf integrates to the fraction of draws that give a
+  // direction (1 for Lambert; GGX loses the reflections that fall below the horizon).
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const Frame frame(normalize(Vec3{0.2f, 0.3f, 1.0f}));
+  for (const Lobe& lobe : smooth_lobes()) {
+    for (const float theta : {10.0f, 45.0f, 75.0f}) {
+      const Vec3 wo = world_wo(theta);
+      const int n = 400000;
+      double sampled = 0.0, taken = 0.0, f_sum = 0.0, f_sq = 0.0, pdf_sum = 0.0, pdf_sq = 0.0;
+      for (int i = 0; i < n; ++i) {
+        BsdfSample s;
+        if (lobe.bsdf.sample(wo, u(gen), u(gen), u(gen), s)) {
+          sampled += s.weight.x;
+          taken += 1.0;
+          EXPECT_NEAR(s.pdf, lobe.bsdf.pdf(wo, s.wi), 1e-3f * s.pdf);
+        }
+        // Uniform on the hemisphere: pdf 1 / (2 pi).
+        const float z = u(gen), phi = 2.0f * kPi * u(gen), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        const Vec3 wi = frame.to_world({r * std::cos(phi), r * std::sin(phi), z});
+        const double f = double(lobe.bsdf.eval(wo, wi).x) * 2.0 * std::numbers::pi;
+        const double p = double(lobe.bsdf.pdf(wo, wi)) * 2.0 * std::numbers::pi;
+        f_sum += f;
+        f_sq += f * f;
+        pdf_sum += p;
+        pdf_sq += p * p;
+      }
+      // Uniform sampling of a narrow lobe is noisy: allow four standard errors of that estimate
+      // plus 0.5 %, which is far below what a wrong factor in eval, pdf or sample would give.
+      const auto bound = [n](double sum, double sq) {
+        const double mean = sum / n, var = std::max(0.0, sq / n - mean * mean);
+        return 4.0 * std::sqrt(var / n) + 0.005 * mean;
+      };
+      EXPECT_NEAR(sampled / n, f_sum / n, bound(f_sum, f_sq)) << lobe.name << " at " << theta;
+      EXPECT_NEAR(pdf_sum / n, taken / n, bound(pdf_sum, pdf_sq)) << lobe.name << " at " << theta;
+    }
+  }
+}
+
+// Chi-square test of `sampled`'s sample() against `judged`'s pdf() (the same BSDF, except when a
+// test checks that the test can fail) over a (theta, phi) grid of the shading hemisphere:
+// expected counts from the pdf integrated per cell, cells below 5 expected pooled; returns the
+// statistic's upper tail probability (Wilson-Hilferty), small when the samples do not follow.
+double chi_square_upper_tail(const Bsdf& sampled, const Bsdf& judged, Vec3 wo, const Frame& frame, uint32_t seed) {
+  constexpr int kTheta = 16, kPhi = 32, kSamples = 400000, kSub = 6;
+  std::vector<double> observed(kTheta * kPhi, 0.0), expected(kTheta * kPhi, 0.0);
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < kSamples; ++i) {
+    BsdfSample s;
+    if (!sampled.sample(wo, u(gen), u(gen), u(gen), s)) continue;
+    const Vec3 l = frame.to_local(s.wi);
+    const double theta = std::acos(std::clamp(double(l.z), -1.0, 1.0));
+    double phi = std::atan2(double(l.y), double(l.x));
+    if (phi < 0) phi += 2.0 * std::numbers::pi;
+    const int ti = std::min(kTheta - 1, int(theta / (std::numbers::pi / 2) * kTheta));
+    const int pi = std::min(kPhi - 1, int(phi / (2.0 * std::numbers::pi) * kPhi));
+    observed[size_t(ti * kPhi + pi)] += 1.0;
+  }
+  const double dt = std::numbers::pi / 2 / kTheta, dp = 2.0 * std::numbers::pi / kPhi;
+  for (int ti = 0; ti < kTheta; ++ti) {
+    for (int pi = 0; pi < kPhi; ++pi) {
+      double sum = 0.0;
+      for (int a = 0; a < kSub; ++a) {
+        for (int b = 0; b < kSub; ++b) {
+          const double theta = (ti + (a + 0.5) / kSub) * dt, phi = (pi + (b + 0.5) / kSub) * dp;
+          const Vec3 l{float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
+                       float(std::cos(theta))};
+          sum += double(judged.pdf(wo, frame.to_world(l))) * std::sin(theta);
+        }
+      }
+      expected[size_t(ti * kPhi + pi)] = sum * dt * dp / (kSub * kSub) * kSamples;
+    }
+  }
+  double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+  int cells = 0;
+  for (size_t i = 0; i < observed.size(); ++i) {
+    if (expected[i] < 5.0) {
+      pooled_obs += observed[i];
+      pooled_exp += expected[i];
+      continue;
+    }
+    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++cells;
+  }
+  if (pooled_exp > 0.0) {
+    chi2 += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
+    ++cells;
+  }
+  const double k = std::max(cells - 1, 1);
+  const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+TEST(Bsdf, ChiSquareSamplesFollowThePdf) {
+  const Frame frame(normalize(Vec3{0.2f, 0.3f, 1.0f}));
+  uint32_t seed = 1;
+  for (const Lobe& lobe : smooth_lobes()) {
+    for (const float theta : {15.0f, 60.0f}) {
+      EXPECT_GT(chi_square_upper_tail(lobe.bsdf, lobe.bsdf, world_wo(theta), frame, seed++), 1e-5)
+          << lobe.name << " at " << theta;
+    }
+  }
+}
+
+TEST(Bsdf, ChiSquareCatchesAWrongPdf) {
+  // The test must be able to fail: samples of a GGX lobe judged by the pdf of a slightly wider
+  // one (Ns 40 against 30), and cosine samples judged by a GGX pdf, are rejected.
+  const Frame frame(normalize(Vec3{0.2f, 0.3f, 1.0f}));
+  const Bsdf narrow = Bsdf::smooth(frame, Vec3{0.0f}, Vec3{1.0f}, Ggx::from_phong_exponent(40.0f));
+  const Bsdf wider = Bsdf::smooth(frame, Vec3{0.0f}, Vec3{1.0f}, Ggx::from_phong_exponent(30.0f));
+  const Bsdf lambert = Bsdf::smooth(frame, Vec3{1.0f}, Vec3{0.0f}, Ggx{1.0f});
+  const Bsdf rough = Bsdf::smooth(frame, Vec3{0.0f}, Vec3{1.0f}, Ggx::from_phong_exponent(0.0f));
+  EXPECT_LT(chi_square_upper_tail(narrow, wider, world_wo(30.0f), frame, 3), 1e-5);
+  EXPECT_LT(chi_square_upper_tail(lambert, rough, world_wo(30.0f), frame, 4), 1e-5);
+}
+
+TEST(Bsdf, DielectricReflectsTheFresnelFractionAndRefractsBySnell) {
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const Frame frame(Vec3{0.0f, 0.0f, 1.0f});
+  for (const float eta : {1.5f, 1.0f / 1.5f}) {
+    const Bsdf glass = Bsdf::dielectric(frame, eta, Vec3{1.0f});
+    for (const float theta : {0.0f, 30.0f, 40.0f, 60.0f}) {
+      const Vec3 wo = direction(theta);
+      const float f = fresnel_dielectric(wo.z, 1.0f, eta);
+      const int n = 100000;
+      int reflected = 0;
+      for (int i = 0; i < n; ++i) {
+        BsdfSample s;
+        ASSERT_TRUE(glass.sample(wo, u(gen), u(gen), u(gen), s));
+        ASSERT_TRUE(s.delta);
+        if (!s.transmitted) {
+          ++reflected;
+          EXPECT_NEAR(s.wi.z, wo.z, 1e-6f);
+          EXPECT_NEAR(s.wi.x, -wo.x, 1e-6f);
+          EXPECT_FLOAT_EQ(s.weight.x, 1.0f);
+        } else {
+          // Snell: sin_t = sin_i / eta; the radiance scales by 1 / eta^2.
+          EXPECT_NEAR(std::sqrt(s.wi.x * s.wi.x + s.wi.y * s.wi.y), std::sin(theta * kPi / 180.0f) / eta, 1e-5f);
+          EXPECT_LT(s.wi.z, 0.0f);
+          EXPECT_NEAR(s.weight.x, 1.0f / (eta * eta), 1e-6f);
+        }
+      }
+      const double frac = double(reflected) / n;
+      EXPECT_NEAR(frac, f, 4.0 * std::sqrt(f * (1.0 - f) / n) + 1e-6) << eta << " " << theta;
+    }
+  }
+  // Normal incidence from air onto n = 1.5: ((n - 1) / (n + 1))^2 = 0.04.
+  EXPECT_NEAR(fresnel_dielectric(1.0f, 1.0f, 1.5f), 0.04f, 1e-6f);
+  // Beyond the critical angle from inside glass, everything reflects.
+  const Bsdf inside = Bsdf::dielectric(frame, 1.0f / 1.5f, Vec3{1.0f});
+  BsdfSample s;
+  ASSERT_TRUE(inside.sample(direction(45.0f), 0.999f, 0.5f, 0.5f, s));
+  EXPECT_FALSE(s.transmitted);
+}
+
+TEST(Bsdf, MaterialsMapToTheirLobes) {
+  Material m;
+  m.illum = 5;
+  m.ks = Vec3{0.9f};
+  EXPECT_EQ(material_bsdf(m, m.kd, Vec3{0, 0, 1}, true).kind(), Bsdf::Kind::Mirror);
+  m.illum = 7;
+  m.ni = 1.33f;
+  EXPECT_EQ(material_bsdf(m, m.kd, Vec3{0, 0, 1}, true).kind(), Bsdf::Kind::Dielectric);
+  m.illum = 2;
+  m.ns = 100.0f;
+  const Bsdf b = material_bsdf(m, Vec3{0.5f}, Vec3{0, 0, 1}, true);
+  EXPECT_EQ(b.kind(), Bsdf::Kind::Smooth);
+  // Kd + Ks = 1.4 is scaled to 1: the white furnace holds for any MTL values.
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double sum = 0.0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    BsdfSample s;
+    if (b.sample(direction(20.0f), u(gen), u(gen), u(gen), s)) sum += s.weight.x;
+  }
+  EXPECT_LE(sum / n, 1.01);
+  EXPECT_GT(sum / n, 0.9);
+}
+
+}  // namespace
+}  // namespace tracer
