@@ -102,7 +102,9 @@ int cmd_render(const RenderArgs& args) {
   const Scene scene = load_scene(args.scene, args.quiet, cancel);
   const double load_ms = ms_since(t_load);
   const CameraSpec camera = camera_for(scene, args);
-  const RenderSettings settings = settings_for(args);
+  std::string lighting_note;
+  const RenderSettings settings = settings_for(args, scene, lighting_note);
+  if (!lighting_note.empty() && !args.quiet) std::cerr << "tracer: note: " << lighting_note << "\n";
   const SchedOptions sched = sched_options_for(args);
   AccelOptions accel_options = accel_options_for(args);
   accel_options.bvh.cancel = cancel;
@@ -113,16 +115,30 @@ int cmd_render(const RenderArgs& args) {
   RenderControl control;
   control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
+  const auto write_image = [&] { write_render(args.output, fb, settings.exposure, exr_pixel_for(args)); };
+  auto last_write = t_render;
+  const auto checkpoint = [&](uint32_t samples) {
+    if (!args.checkpoint || samples >= uint32_t(settings.spp)) return;
+    if (ms_since(last_write) < *args.checkpoint * 1e3) return;
+    write_image();
+    last_write = std::chrono::steady_clock::now();
+  };
   bool finished;
   {
-    ProgressBar progress(!args.quiet, uint64_t(settings.width) * uint64_t(settings.height), control.pixels_done,
-                         control.rays_done);
-    finished = render_image(accel, ctx, sched, control);
+    const uint64_t work = uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp);
+    ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
+    finished = render_passes(accel, ctx, sched, control, checkpoint);
   }
   const double render_ms = ms_since(t_render);
   if (!finished) {
-    if (args.save_partial && control.pixels_done.load() > 0) {
-      write_render(args.output, fb, settings.exposure, exr_pixel_for(args));
+    // A path render stopped after its first pass is a complete image, only noisier.
+    const uint32_t samples = fb.min_samples();
+    if (samples > 0) {
+      write_image();
+      std::cerr << "tracer: " << stop_signal_name() << " after " << samples << " of " << settings.spp
+                << " samples per pixel; image written to " << args.output << "\n";
+    } else if (args.save_partial && control.pixels_done.load() > 0) {
+      write_image();
       std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << args.output << "\n";
     } else {
       std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
@@ -130,7 +146,7 @@ int cmd_render(const RenderArgs& args) {
     }
     return exit_code_for_stop();
   }
-  write_render(args.output, fb, settings.exposure, exr_pixel_for(args));
+  write_image();
   if (stop_signal() != 0) {  // arrived during the final write, which is never torn
     std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output
               << "\n";

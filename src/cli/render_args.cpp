@@ -38,10 +38,22 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--fov", a.fov, "vertical field of view in degrees (default 53.13)");
   app.add_option("--integrator", a.integrator,
                  "what a pixel is made of: ao (the study's workload: direct light, ambient occlusion, every surface "
-                 "diffuse) or whitted (mirrors and glass from the MTL, hard shadows)")
+                 "diffuse), whitted (mirrors and glass from the MTL, hard shadows) or path (path tracing: every "
+                 "material, emissive triangles as area lights, soft shadows, indirect light)")
       ->capture_default_str();
-  app.add_option("--max-depth", s.max_depth, "whitted: reflections and refractions followed per path (0-64)")
+  app.add_option("--max-depth", s.max_depth,
+                 "whitted: reflections and refractions followed; path: bounces per path (0-64)")
       ->capture_default_str();
+  app.add_option("--spp", a.spp,
+                 "path: samples per pixel (1-1048576, default " + std::to_string(kDefaultPathSpp) + ")");
+  app.add_option("--env", a.env,
+                 "path: radiance r,g,b of a uniform environment (default black; white when the scene has no light)");
+  app.add_option("--light-sampling", a.light_sampling,
+                 "path: " + names_of<LightSampling>(kLightSamplingNames) +
+                     " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
+      ->capture_default_str();
+  app.add_option("--checkpoint", a.checkpoint,
+                 "path: rewrite the output every this many seconds while samples accumulate");
   app.add_option("--ao", s.ao_samples, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
   app.add_option("--ao-distance", a.ao_distance, "maximum distance of AO rays (default: unbounded)");
   app.add_option("--ambient", s.ambient, "ambient light strength")->capture_default_str();
@@ -83,6 +95,14 @@ void validate(const RenderArgs& a) {
   check_range("--height", s.height, 1, 16384);
   check_range("--ao", s.ao_samples, 0, 4096);
   check_range("--max-depth", s.max_depth, 0, 64);
+  if (a.spp) check_range("--spp", *a.spp, 1, 1 << 20);
+  if (a.checkpoint) check_range_real("--checkpoint", *a.checkpoint, 0.0, 1e9, true);
+  if (!a.env.empty()) {
+    const Vec3 env = parse_vec3("--env", a.env);
+    if (env.x < 0.0f || env.y < 0.0f || env.z < 0.0f || max_component(env) > 1e30f) {
+      throw UsageError("--env: each component must be in [0, 1e30], got '" + a.env + "'");
+    }
+  }
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
   if (a.fov) check_range_real("--fov", *a.fov, 0.0, 179.0, true);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
@@ -136,7 +156,10 @@ namespace {
 
 // --no-scene-lights and --light, on top of the scene's (or the view's) lights.
 void add_lights(Scene& scene, const SceneArgs& a) {
-  if (a.no_scene_lights) scene.lights.clear();
+  if (a.no_scene_lights) {
+    scene.lights.clear();
+    scene.emitters = Emitters{};
+  }
   const float intensity = a.light_intensity ? float(*a.light_intensity) : scene.default_light_intensity();
   for (const std::string& text : a.lights) {
     Light l;
@@ -195,11 +218,32 @@ RenderSettings settings_for(const RenderArgs& a) {
   RenderSettings s = a.settings;
   if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
   s.integrator = parse_name<Integrator>(kIntegratorNames, a.integrator, "--integrator", "integrator");
+  s.light_sampling =
+      parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
+  const bool path = s.integrator == Integrator::Path;
+  for (const auto& [flag, given] :
+       {std::pair{"--spp", a.spp.has_value()}, {"--env", !a.env.empty()}, {"--checkpoint", a.checkpoint.has_value()}}) {
+    if (given && !path) throw UsageError(std::string(flag) + ": only for --integrator path");
+  }
+  s.spp = path ? a.spp.value_or(kDefaultPathSpp) : 1;
+  if (!a.env.empty()) s.environment = parse_vec3("--env", a.env);
   // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
   // not for whitted, whose rays go one at a time.
   const bool by_default = s.packets && !a.no_packets && a.simd != "off";
   s.packets =
       (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
+  return s;
+}
+
+RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
+  RenderSettings s = settings_for(a);
+  note.clear();
+  const bool point_lights =
+      std::any_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return l.is_point(); });
+  if (s.integrator == Integrator::Path && a.env.empty() && scene.emitters.empty() && !point_lights) {
+    s.environment = Vec3{1.0f};
+    note = scene.source + " has no emissive material and no --light: lit by a uniform white environment (--env 1,1,1)";
+  }
   return s;
 }
 

@@ -45,6 +45,10 @@ struct RenderArgs {
   std::string simd = "auto";
   std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
   std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
+  std::string light_sampling{name_of<LightSampling>(kLightSamplingNames, RenderSettings{}.light_sampling)};
+  std::optional<int> spp;            // path: samples per pixel (default kDefaultPathSpp)
+  std::string env;                   // path: uniform environment radiance r,g,b
+  std::optional<double> checkpoint;  // path: seconds between rewrites of the output
   std::optional<int> threads;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;
@@ -61,6 +65,11 @@ Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr)
 void check_outputs(const RenderArgs& args);
 CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 RenderSettings settings_for(const RenderArgs& args);
+// The path integrator's samples per pixel when --spp is not given.
+inline constexpr int kDefaultPathSpp = 64;
+// settings_for() plus what depends on the scene: a path render of a scene with no emitter, no
+// point light and no --env gets a uniform white environment, and `note` says so.
+RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
 AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);

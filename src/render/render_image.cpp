@@ -1,5 +1,7 @@
 #include "render/render_image.hpp"
 
+#include <algorithm>
+
 namespace tracer {
 
 bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
@@ -10,9 +12,31 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
         const RayCounts counts = accel.visit([&](const auto& a) { return render_tile(a, ctx, tile); });
         control.counts.add(counts);
         control.rays_done.fetch_add(counts.total(), std::memory_order_relaxed);
-        control.pixels_done.fetch_add(uint64_t(tile.pixel_count()), std::memory_order_relaxed);
+        control.pixels_done.fetch_add(uint64_t(tile.pixel_count()) * ctx.samples.count, std::memory_order_relaxed);
         if (control.on_tile) control.on_tile(tile);
       });
+}
+
+std::vector<SampleRange> sample_passes(const RenderSettings& settings) {
+  if (settings.integrator != Integrator::Path) return {SampleRange{0, 1}};
+  std::vector<SampleRange> passes;
+  const uint32_t total = uint32_t(std::max(settings.spp, 1));
+  for (uint32_t done = 0; done < total;) {
+    const uint32_t count = std::min({total - done, std::max(done, 1u), kMaxPassSamples});
+    passes.push_back({done, count});
+    done += count;
+  }
+  return passes;
+}
+
+bool render_passes(const Accelerator& accel, RenderContext ctx, const SchedOptions& options, RenderControl& control,
+                   const std::function<void(uint32_t)>& after_pass) {
+  for (const SampleRange& pass : sample_passes(ctx.settings)) {
+    ctx.samples = pass;
+    if (!render_image(accel, ctx, options, control)) return false;
+    if (after_pass) after_pass(pass.first + pass.count);
+  }
+  return true;
 }
 
 }  // namespace tracer

@@ -1,11 +1,12 @@
-// Rendering a whole image: the workload of shading.hpp over every tile, handed out by one of the
-// parallel_for_tiles() strategies. Every strategy renders disjoint tiles with the same per-pixel
-// work, so the image is the same from each.
+// Rendering a whole image: the workload of render_tile.hpp over every tile, handed out by one of
+// the parallel_for_tiles() strategies, in one or more passes of samples. Every strategy renders
+// disjoint tiles with the same per-pixel work, so the image is the same from each.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "accel/accelerator.hpp"
 #include "base/errors.hpp"
@@ -16,17 +17,29 @@ namespace tracer {
 
 // Shared between the render, the caller (progress, cancellation) and tests.
 struct RenderControl {
-  CancelFlag cancel = nullptr;  // set (e.g. by SIGINT) to stop at the next tile
-  std::atomic<uint64_t> pixels_done{0};
+  CancelFlag cancel = nullptr;           // set (e.g. by SIGINT) to stop at the next tile
+  std::atomic<uint64_t> pixels_done{0};  // pixel samples, over all passes
   std::atomic<uint64_t> rays_done{0};
   AtomicRayCounts counts;
   std::function<void(const Tile&)> on_tile;  // test hook, called once per rendered tile
   bool cancelled() const { return is_cancelled(cancel); }
 };
 
-// Renders ctx.framebuffer with `accel`. Returns false if cancelled before finishing (tiles not
-// reached are left untouched).
+// Renders ctx.samples of every pixel into ctx.framebuffer with `accel`. Returns false if
+// cancelled before finishing (tiles not reached are left untouched).
 bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
                   RenderControl& control);
+
+// The passes of a render: ao and whitted take one sample per pixel; path takes settings.spp in
+// passes that double (1, 1, 2, 4, ... at most kMaxPassSamples), so a checkpoint or a stop finds
+// a complete image early and later passes keep the tile overhead small.
+inline constexpr uint32_t kMaxPassSamples = 64;
+std::vector<SampleRange> sample_passes(const RenderSettings& settings);
+
+// Every pass of sample_passes(), in order; after each finished pass calls after_pass with the
+// samples per pixel so far. Returns false if cancelled (the framebuffer then holds the finished
+// passes plus whatever tiles of the stopped one completed).
+bool render_passes(const Accelerator& accel, RenderContext ctx, const SchedOptions& options, RenderControl& control,
+                   const std::function<void(uint32_t)>& after_pass = {});
 
 }  // namespace tracer

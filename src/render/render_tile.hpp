@@ -3,6 +3,7 @@
 #pragma once
 
 #include "render/ao.hpp"
+#include "render/path.hpp"
 #include "render/whitted.hpp"
 
 namespace tracer {
@@ -10,6 +11,10 @@ namespace tracer {
 template <class Accel>
 RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile) {
   RayCounts counts;
+  if (ctx.settings.integrator == Integrator::Path) {
+    path_tile(accel, ctx, tile, counts);
+    return counts;
+  }
   if (ctx.settings.integrator == Integrator::Whitted) {
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x = tile.x0; x < tile.x1; ++x) {

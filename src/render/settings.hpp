@@ -14,10 +14,18 @@
 namespace tracer {
 
 // What a pixel's radiance is made of: the study's workload (direct light from the lights'
-// centroids, ambient occlusion, every surface diffuse), or Whitted ray tracing (direct light
-// with hard shadows, perfect mirror reflection and dielectric refraction to max_depth).
-enum class Integrator { Ao, Whitted };
-inline constexpr EnumName<Integrator> kIntegratorNames[] = {{Integrator::Ao, "ao"}, {Integrator::Whitted, "whitted"}};
+// centroids, ambient occlusion, every surface diffuse), Whitted ray tracing (direct light with
+// hard shadows, perfect mirror reflection and dielectric refraction to max_depth), or unbiased
+// path tracing (every material of the MTL, emissive triangles as area lights).
+enum class Integrator { Ao, Whitted, Path };
+inline constexpr EnumName<Integrator> kIntegratorNames[] = {
+    {Integrator::Ao, "ao"}, {Integrator::Whitted, "whitted"}, {Integrator::Path, "path"}};
+
+// How the path integrator finds light: next-event estimation combined with BSDF sampling by
+// multiple importance sampling, or BSDF sampling alone (the unbiased reference NEE must match).
+enum class LightSampling { Mis, Bsdf };
+inline constexpr EnumName<LightSampling> kLightSamplingNames[] = {{LightSampling::Mis, "mis"},
+                                                                  {LightSampling::Bsdf, "bsdf"}};
 
 struct RenderSettings {
   int width = 1024;
@@ -28,7 +36,10 @@ struct RenderSettings {
   float exposure = 1.5f;          // tone-mapping exposure
   uint32_t seed = 0;
   Integrator integrator = Integrator::Ao;
-  int max_depth = 8;  // whitted: reflections and refractions followed per path
+  int max_depth = 8;       // whitted: reflections and refractions followed; path: bounces per path
+  int spp = 1;             // path: samples per pixel
+  Vec3 environment{0.0f};  // path: radiance arriving from every direction no surface blocks
+  LightSampling light_sampling = LightSampling::Mis;
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
@@ -58,12 +69,18 @@ struct AtomicRayCounts {
   RayCounts load() const { return {primary.load(), shadow.load(), ao.load(), secondary.load()}; }
 };
 
+// The samples of each pixel one pass adds: [first, first + count).
+struct SampleRange {
+  uint32_t first = 0, count = 1;
+};
+
 // Everything one tile needs; shared read-only by all workers except the disjoint framebuffer pixels.
 struct RenderContext {
   const Scene* scene = nullptr;
   Camera camera;
   RenderSettings settings;
   Framebuffer* framebuffer = nullptr;
+  SampleRange samples;  // path: this pass's samples (ao and whitted take one, at the pixel centre)
 };
 
 }  // namespace tracer

@@ -40,9 +40,13 @@ class Camera {
     inv_h_ = 1.0f / float(height);
   }
 
-  Ray primary_ray(int x, int y) const {
-    const float sx = 2.0f * (float(x) + 0.5f) * inv_w_ - 1.0f;
-    const float sy = 1.0f - 2.0f * (float(y) + 0.5f) * inv_h_;
+  // The ray through the centre of pixel (x, y).
+  Ray primary_ray(int x, int y) const { return ray_through(float(x) + 0.5f, float(y) + 0.5f); }
+
+  // The ray through image position (px, py), in pixels from the top-left corner.
+  Ray ray_through(float px, float py) const {
+    const float sx = 2.0f * px * inv_w_ - 1.0f;
+    const float sy = 1.0f - 2.0f * py * inv_h_;
     Ray r;
     r.org = eye_;
     r.dir = normalize(forward_ + du_ * sx + dv_ * sy);

@@ -45,11 +45,11 @@ void Scene::finalize() {
     float area = 0;
     Vec3 ke;
   };
-  std::map<std::pair<uint32_t, uint32_t>, Accum> emitters;
+  std::map<std::pair<uint32_t, uint32_t>, Accum> by_source;
   for (size_t i = 0; i < triangles.size(); ++i) {
     const Material& m = materials[tri_material[i]];
     if (!m.emissive() || triangles[i].degenerate()) continue;
-    Accum& a = emitters[{tri_geom[i], tri_material[i]}];
+    Accum& a = by_source[{tri_geom[i], tri_material[i]}];
     const Vec3 n = triangles[i].normal();
     const float area = 0.5f * length(n);
     a.weighted_centroid += triangles[i].centroid() * area;
@@ -57,7 +57,7 @@ void Scene::finalize() {
     a.area += area;
     a.ke = m.ke;
   }
-  for (const auto& [key, a] : emitters) {
+  for (const auto& [key, a] : by_source) {
     if (a.area <= 0.0f) continue;
     Light l;
     l.position = a.weighted_centroid / a.area;
@@ -68,6 +68,7 @@ void Scene::finalize() {
     l.geomID = key.first;
     lights.push_back(l);
   }
+  emitters = Emitters(*this);
 }
 
 }  // namespace tracer

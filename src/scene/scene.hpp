@@ -10,6 +10,7 @@
 #include "base/invalid_index.hpp"
 #include "math/aabb.hpp"
 #include "math/vec.hpp"
+#include "scene/emitters.hpp"
 
 namespace tracer {
 
@@ -91,6 +92,7 @@ struct Scene {
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
   std::vector<Light> lights;
+  Emitters emitters;  // the emissive triangles, for the path integrator's light sampling
   size_t vertex_count = 0;
   size_t degenerate_count = 0;
   Aabb bounds;
@@ -105,7 +107,7 @@ struct Scene {
   // Appends a geometry from an indexed mesh; material is an index into `materials`.
   void add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
                 uint32_t material);
-  // Recomputes bounds, degenerate count and the area lights from emissive materials.
+  // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials.
   void finalize();
 };
 

@@ -1,0 +1,48 @@
+// The emissive triangles as area lights for the path integrator: each with its true area and
+// normal, chosen in proportion to its power (luminance of Ke times area), a point on it uniformly
+// by area. Emission is one-sided, from the face the winding makes the front (counter-clockwise
+// seen from the lit side), as in pbrt and the measured Cornell box: a lamp mounted just below a
+// ceiling must not light the gap above it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "math/vec.hpp"
+
+namespace tracer {
+
+struct Scene;
+
+struct EmitterSample {
+  Vec3 point;  // on the emitter
+  Vec3 wi;     // unit direction from the shading point to `point`
+  float distance;
+  Vec3 radiance;  // Ke of the emitter
+  float pdf;      // solid-angle density at the shading point (selection times area density)
+};
+
+class Emitters {
+ public:
+  Emitters() = default;
+  // Every non-degenerate triangle with an emissive material.
+  explicit Emitters(const Scene& scene);
+  bool empty() const { return tris_.empty(); }
+  size_t size() const { return tris_.size(); }
+  // A point on an emitter seen from `from`, by three uniform numbers; false if it has no solid
+  // angle there (seen edge-on or from behind, or `from` lies on it).
+  bool sample(const Scene& scene, Vec3 from, float u_select, float u1, float u2, EmitterSample& out) const;
+  // The solid-angle density with which sample() picks the point `to` on scene triangle `tri`
+  // from `from`: 0 when `tri` is not one of the emitters.
+  float pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const;
+  // The probability of choosing scene triangle `tri` (0 if it is not an emitter).
+  float selection_probability(uint32_t tri) const;
+
+ private:
+  std::vector<uint32_t> tris_;  // scene triangle indices, ascending
+  std::vector<float> cdf_;      // cdf_[i]: the probability of choosing one of tris_[0..i]
+  std::vector<float> pmf_;      // probability of choosing tris_[i]
+  std::vector<float> area_;
+};
+
+}  // namespace tracer
