@@ -39,6 +39,11 @@ struct Vec3 {
   friend constexpr bool operator==(Vec3 a, Vec3 b) = default;
 };
 
+// Texture coordinates.
+struct Vec2 {
+  float x = 0, y = 0;
+};
+
 constexpr Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 constexpr Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 constexpr Vec3 operator*(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }

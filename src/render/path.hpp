@@ -46,7 +46,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     }
     if (depth >= s.max_depth) break;
     const uint32_t dim = kPathPixelDims + uint32_t(depth) * kPathDims;
-    const Bsdf bsdf = material_bsdf(mat, mat.kd, sp.shading_n, sp.front);
+    const Bsdf bsdf = material_bsdf(mat, diffuse_color(scene, hit, mat), sp.shading_n, sp.front);
     const Vec3 wo = -ray.dir;
     if (!bsdf.delta()) {
       // One emitter sample: Ke * f * cos / pdf, weighted against BSDF sampling.

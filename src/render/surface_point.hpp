@@ -59,4 +59,14 @@ inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
   return dot(unit, n) < 0.0f ? -unit : unit;
 }
 
+// The diffuse colour at a hit: the material's map_Kd texture, filtered bilinearly at the
+// interpolated texture coordinates, where it has one and the triangle has coordinates; else Kd.
+inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat) {
+  if (mat.diffuse_texture == kInvalidIndex || scene.corner_uvs.empty()) return mat.kd;
+  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
+  const float w = 1.0f - hit.u - hit.v;
+  return scene.textures[mat.diffuse_texture].bilinear(c[0].x * w + c[1].x * hit.u + c[2].x * hit.v,
+                                                      c[0].y * w + c[1].y * hit.u + c[2].y * hit.v);
+}
+
 }  // namespace tracer

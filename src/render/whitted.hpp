@@ -50,8 +50,10 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
     case SurfaceKind::Diffuse:
       break;
   }
+  const Vec3 kd = diffuse_color(*ctx.scene, hit, mat);
+  sp.albedo_over_pi = kd * std::numbers::inv_pi_v<float>;
   add_direct_light(accel, ctx, sp, counts);
-  return sp.color + mat.kd * ctx.settings.ambient;
+  return sp.color + kd * ctx.settings.ambient;
 }
 
 }  // namespace tracer

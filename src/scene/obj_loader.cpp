@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <streambuf>
 #include <string_view>
@@ -20,6 +21,7 @@
 
 #include "base/text.hpp"
 #include "io/read_input.hpp"
+#include "scene/texture.hpp"
 
 namespace tracer {
 namespace {
@@ -291,29 +293,46 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     }
   }
 
+  // map_Kd textures, each file loaded once; one warning for all that are missing or unreadable.
+  // The other maps (bump, Ks, Ka, alpha) are not used by any integrator, so not read.
   size_t missing_textures = 0;
   std::string first_missing;
+  std::map<fs::path, uint32_t> texture_index;
   for (const tinyobj::material_t& m : parsed.materials) {
-    for (const std::string* tex :
-         {&m.diffuse_texname, &m.ambient_texname, &m.specular_texname, &m.bump_texname, &m.alpha_texname}) {
-      std::error_code ec;
-      if (!tex->empty() && !fs::exists(base_dir / *tex, ec)) {
-        if (missing_textures++ == 0) first_missing = *tex;
+    Material mat = to_material(m, name);
+    if (!m.diffuse_texname.empty()) {
+      throw_if_cancelled(cancel);
+      const std::optional<fs::path> file = find_file_any_case(base_dir, m.diffuse_texname);
+      std::string problem;
+      if (!file) {
+        problem = "not found";
+      } else if (const auto it = texture_index.find(*file); it != texture_index.end()) {
+        mat.diffuse_texture = it->second;
+      } else {
+        try {
+          scene.textures.push_back(load_texture(*file));
+          mat.diffuse_texture = texture_index[*file] = static_cast<uint32_t>(scene.textures.size() - 1);
+        } catch (const InputError& e) {
+          problem = e.what();
+        }
       }
+      if (!problem.empty() && missing_textures++ == 0) first_missing = in_quotes(m.diffuse_texname) + ": " + problem;
     }
-    scene.materials.push_back(to_material(m, name));
+    scene.materials.push_back(std::move(mat));
   }
   if (missing_textures > 0) {
-    warnings.add(std::to_string(missing_textures) +
-                 " texture reference(s) not found (first: " + in_quotes(first_missing) + "); using material colours");
+    warnings.add(std::to_string(missing_textures) + " map_Kd texture(s) not used (first " + first_missing +
+                 "); those materials use Kd");
   }
   const auto default_material = static_cast<uint32_t>(scene.materials.size());
   bool used_default = false;
 
   size_t faces_seen = 0;
   const size_t normal_count = attrib.normals.size() / 3;
-  bool any_normal = false;
+  const size_t uv_count = attrib.texcoords.size() / 2;
+  bool any_normal = false, any_uv = false;
   std::vector<Vec3> corner_normals;
+  std::vector<Vec2> corner_uvs;
   for (const tinyobj::shape_t& shape : parsed.shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     Geometry g;
@@ -344,6 +363,18 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
             any_normal = true;
           }
           corner_normals.push_back(normal);
+          const int ti = mesh.indices[offset + k].texcoord_index;
+          Vec2 uv;
+          if (ti >= 0) {
+            if (size_t(ti) >= uv_count)
+              throw InputError(name + ": face " + std::to_string(faces_seen) +
+                               " has a texture coordinate index out of range");
+            uv = {attrib.texcoords[2 * size_t(ti)], attrib.texcoords[2 * size_t(ti) + 1]};
+            if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+              throw InputError(name + ": texture coordinate " + std::to_string(ti + 1) + " is not finite");
+            any_uv = true;
+          }
+          corner_uvs.push_back(uv);
         }
         const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
         uint32_t material = default_material;
@@ -365,6 +396,7 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   if (used_default) scene.materials.push_back(Material{});
   if (scene.triangles.empty()) throw InputError(name + ": scene has no triangles");
   if (any_normal) scene.corner_normals = std::move(corner_normals);
+  if (any_uv) scene.corner_uvs = std::move(corner_uvs);
   scene.finalize();
   return scene;
 }

@@ -28,6 +28,7 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
   }
   vertex_count += vertices.size();
   if (!corner_normals.empty()) corner_normals.resize(3 * triangles.size(), Vec3{0.0f});  // none for this mesh
+  if (!corner_uvs.empty()) corner_uvs.resize(3 * triangles.size(), Vec2{});
   geometries.push_back(std::move(g));
 }
 

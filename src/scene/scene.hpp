@@ -11,6 +11,7 @@
 #include "math/aabb.hpp"
 #include "math/vec.hpp"
 #include "scene/emitters.hpp"
+#include "scene/texture.hpp"
 
 namespace tracer {
 
@@ -46,6 +47,9 @@ struct Material {
   float ns = 0.0f;
   float ni = 1.0f;
   int illum = 2;
+  // map_Kd: an index into Scene::textures, or kInvalidIndex. Where present it replaces Kd (the
+  // exporters' convention: Sponza's Kd is its texture's mean, so a product would darken it twice).
+  uint32_t diffuse_texture = kInvalidIndex;
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
   // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.
@@ -89,6 +93,9 @@ struct Scene {
   // none; zero at the corners of faces that give none. The ao workload shades with the geometric
   // normal; whitted interpolates these.
   std::vector<Vec3> corner_normals;
+  // Texture coordinates from the file's `vt`, three per triangle, or empty when it has none.
+  std::vector<Vec2> corner_uvs;
+  std::vector<Texture> textures;
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
   std::vector<Light> lights;
