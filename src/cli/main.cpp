@@ -43,6 +43,9 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
           {"render_ms", render_ms},
           {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
           {"max_depth", settings.max_depth},
+          {"spp", settings.spp},
+          {"samples_per_s",
+           render_ms > 0 ? double(settings.width) * settings.height * settings.spp / (render_ms * 1e-3) : 0.0},
           {"rays",
            {{"primary", rays.primary},
             {"shadow", rays.shadow},
@@ -57,10 +60,12 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   const auto str = [&](const char* k) { return j[k].get<std::string>(); };
   std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
-  const std::string workload =
-      str("integrator") == "ao"
-          ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
-          : "whitted, at most " + std::to_string(j["max_depth"].get<int>()) + " reflections/refractions";
+  const std::string integrator = str("integrator");
+  const std::string depth = std::to_string(j["max_depth"].get<int>());
+  const std::string workload = integrator == "ao" ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
+                               : integrator == "whitted" ? "whitted, at most " + depth + " reflections/refractions"
+                                                         : "path, " + std::to_string(j["spp"].get<int>()) +
+                                                               " samples per pixel, at most " + depth + " bounces";
   std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
               str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
@@ -78,11 +83,13 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
   std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
   const auto& r = j["rays"];
-  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted, %llu total\n",
+  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted/bounced, %llu total\n",
               r["primary"].get<unsigned long long>(), r["shadow"].get<unsigned long long>(),
               r["ao"].get<unsigned long long>(), r["secondary"].get<unsigned long long>(),
               r["total"].get<unsigned long long>());
-  std::printf("throughput   %10.2f Mrays/s\n", j["mrays_per_s"].get<double>());
+  std::printf("throughput   %10.2f Mrays/s", j["mrays_per_s"].get<double>());
+  if (integrator == "path") std::printf(", %.3f Msamples/s", j["samples_per_s"].get<double>() * 1e-6);
+  std::printf("\n");
 }
 
 int cmd_render(const RenderArgs& args) {
