@@ -13,6 +13,9 @@ chmod 755 "$work"  # the unprivileged case must reach its file
 trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
+# Written before ok.obj: files newer than ok.obj are what a case left behind, and are removed.
+printf 'mtllib tex.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 2/2 3/3\n' > tex.obj
+printf 'newmtl a\nmap_Kd Missing.PNG\nnewmtl b\nmap_Kd missing.png\n' > tex.mtl
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > ok.obj
 printf '# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n' > cr.obj
 printf 'v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n' > nan.obj
@@ -38,6 +41,7 @@ inputs=$(ls)
 as_user=()
 [[ $(id -u) -eq 0 ]] && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
 SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
+PATH_RENDER="render ok.obj -q --integrator path --spp 1000000 --width 128 --height 128 -o out.png"
 
 # case | command (run by bash in the work directory) | expected exit code
 cases=(
@@ -64,6 +68,11 @@ cases=(
   "--threads 0|tracer render --threads 0 -q|2"
   "one allowed core (taskset -c 0), default threads|taskset -c 0 tracer render -q --width 32 --height 32 -o t.png|0"
   "--threads 64 on a smaller machine|tracer render --threads 64 -q --width 32 --height 32 -o t.png|0"
+  "--spp 0|tracer render --integrator path --spp 0 -q|2"
+  "--spp without --integrator path|tracer render --spp 16 -q|2"
+  "--env with a negative component|tracer render --integrator path --env 1,-1,1 -q|2"
+  "--checkpoint 0|tracer render --integrator path --checkpoint 0 -q|2"
+  "two materials name a missing texture|tracer render tex.obj --width 32 --height 32 -o t.png|0"
   "bench --variants ''|tracer bench --variants ''|2"
   "bench --scenes ,|tracer bench --scenes ,|2"
   "bench --size 32x32x99junk|tracer bench --size 32x32x99junk|2"
@@ -75,6 +84,7 @@ cases=(
   "SIGHUP while rendering|timeout --foreground --preserve-status -s HUP 1 tracer $SLOW|129"
   "Ctrl-C while the scene is still arriving, --save-partial|(sleep 5 > silent.obj &) ; timeout --foreground --preserve-status -s INT 1 tracer render silent.obj -q --save-partial -o out.png|130"
   "kill -9 while rendering|timeout --foreground --preserve-status -s KILL 1 tracer $SLOW|137"
+  "Ctrl-C during a path render (after its first pass)|timeout --foreground --preserve-status -s INT 2 tracer $PATH_RENDER|130"
 )
 
 table=$'| case | command | exit | first line on stderr | left in the directory |\n|---|---|---:|---|---|\n'
@@ -85,7 +95,8 @@ for c in "${cases[@]}"; do
   run=${run//USER /\"\$\{as_user[@]\}\" }
   stderr=$(tracer=$tracer bash -c "as_user=(${as_user[*]}); $run" 2>&1 >/dev/null)
   code=$?
-  first=$(printf '%s\n' "$stderr" | head -n 1)
+  # How many samples a stopped path render finished depends on the machine's speed: shown as N.
+  first=$(printf '%s\n' "$stderr" | head -n 1 | sed -E 's/after [0-9]+ of/after N of/')
   [[ -z $first ]] && first="(nothing)"
   left=$(comm -13 <(echo "$inputs") <(ls) | tr '\n' ' ')
   left=${left% }

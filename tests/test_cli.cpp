@@ -88,6 +88,14 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --eye 0,1,1e19 --look 0,1,0", 2, "--eye: coordinates must lie within +-1e18, got '0,1,1e19'"},
       {"render --light 1e30,0,0", 2, "--light: coordinates must lie within +-1e18"},
       {"render SAME", 1, "same.obj: all vertices coincide"},
+      {"render --integrator foo", 2, "--integrator: unknown integrator 'foo'"},
+      {"render --integrator path --spp 0", 2, "--spp: must be between 1 and 1048576, got 0"},
+      {"render --spp 16", 2, "--spp: only for --integrator path"},
+      {"render --integrator whitted --env 1,1,1", 2, "--env: only for --integrator path"},
+      {"render --integrator path --env 1,-1,1", 2, "--env: each component must be in [0, 1e30], got '1,-1,1'"},
+      {"render --integrator path --env 1,1", 2, "--env: expected three finite numbers"},
+      {"render --integrator path --light-sampling nee", 2, "--light-sampling: unknown light sampling 'nee'"},
+      {"render --integrator path --checkpoint 0", 2, "--checkpoint: must be above 0"},
       {"render RANGE --stats-json RANGE", 2, "range.obj' is the input scene"},
       {"bench --variants ''", 2, "--variants: empty name in ''"},
       {"bench --scenes ,", 2, "--scenes: empty name in ','"},
@@ -160,6 +168,53 @@ TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
   EXPECT_EQ(j["scene"], scene);
   EXPECT_EQ(j["rays"]["primary"], 48);
   EXPECT_EQ(j["width"], 8);
+}
+
+TEST_F(Cli, PathStatsCountSamplesAndCheckpoints) {
+  // 16 spp runs in passes of 1, 1, 2, 4 and 8: with a checkpoint due after every pass, the output
+  // is rewritten after each but the last (which writes the final image).
+  const auto r = test::run_tracer("render -q --integrator path --spp 16 --checkpoint 1e-9 --width 8 --height 6 -o " +
+                                  dir_ + "/p.png --stats-json " + dir_ + "/p.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir_ + "/p.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["integrator"], "path");
+  EXPECT_EQ(j["spp"], 16);
+  EXPECT_EQ(j["rays"]["primary"], 8 * 6 * 16);
+  EXPECT_GT(j["rays"]["shadow"].get<int>(), 0);
+  EXPECT_GT(j["rays"]["secondary"].get<int>(), 0);
+  EXPECT_EQ(j["rays"]["ao"], 0);
+  EXPECT_EQ(j["checkpoints_written"], 4);
+  EXPECT_GT(j["samples_per_s"].get<double>(), 0.0);
+  EXPECT_EQ(read_image(dir_ + "/p.png").width, 8);
+}
+
+TEST_F(Cli, SceneWithoutLightsIsLitByAWhiteEnvironmentWithANote) {
+  const auto r = test::run_tracer("render " + dir_ + "/ok.obj --integrator path --spp 2 --width 8 --height 8 -o " +
+                                  dir_ + "/e.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("tracer: note: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(--env 1,1,1)"), std::string::npos) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  // The same with a light says nothing.
+  const auto lit = test::run_tracer("render " + dir_ + "/ok.obj --integrator path --spp 2 --width 8 --height 8 " +
+                                    "--light 0,0,5 -o " + dir_ + "/e.png");
+  ASSERT_EQ(lit.exit_code, 0) << lit.output;
+  EXPECT_EQ(lit.output, "");
+}
+
+TEST_F(Cli, CtrlCDuringAPathRenderWritesTheSamplesSoFar) {
+  // After the first pass every pixel has a sample: Ctrl-C writes that complete (noisier) image.
+  const std::string out = dir_ + "/progressive.png";
+  const std::string cmd = "timeout --foreground --preserve-status -s INT 2 " + std::string(TRACER_EXE) +
+                          " render -q --integrator path --spp 1000000 --width 64 --height 48 -o " + out + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  ASSERT_TRUE(fs::exists(out));
+  const Image8 img = read_image(out);
+  EXPECT_EQ(img.width, 64);
+  EXPECT_EQ(img.height, 48);
 }
 
 TEST_F(Cli, BenchJsonParsesBack) {

@@ -124,10 +124,12 @@ int cmd_render(const RenderArgs& args) {
   const auto t_render = std::chrono::steady_clock::now();
   const auto write_image = [&] { write_render(args.output, fb, settings.exposure, exr_pixel_for(args)); };
   auto last_write = t_render;
+  int checkpoints = 0;
   const auto checkpoint = [&](uint32_t samples) {
     if (!args.checkpoint || samples >= uint32_t(settings.spp)) return;
     if (ms_since(last_write) < *args.checkpoint * 1e3) return;
     write_image();
+    ++checkpoints;
     last_write = std::chrono::steady_clock::now();
   };
   bool finished;
@@ -159,8 +161,8 @@ int cmd_render(const RenderArgs& args) {
               << "\n";
     return exit_code_for_stop();
   }
-  const nlohmann::json stats =
-      render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
+  nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
+  stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);
   if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
   return 0;
