@@ -15,18 +15,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The sRGB transfer curve inverted, for each 8-bit code.
-const std::array<float, 256>& srgb_to_linear() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) {
-      const float c = float(i) / 255.0f;
-      t[size_t(i)] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-    }
-    return t;
-  }();
-  return table;
-}
+// The sRGB transfer curve inverted, for each 8-bit code; a namespace-scope table, so a lookup
+// has no function-local-static guard to check.
+const std::array<float, 256> kSrgbToLinear = [] {
+  std::array<float, 256> t{};
+  for (int i = 0; i < 256; ++i) {
+    const float c = float(i) / 255.0f;
+    t[size_t(i)] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  }
+  return t;
+}();
 
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -39,7 +37,7 @@ Texture::Texture(int width, int height, std::vector<uint8_t> srgb)
     : width_(width), height_(height), srgb_(std::move(srgb)) {}
 
 Vec3 Texture::texel(int x, int y) const {
-  const auto& lut = srgb_to_linear();
+  const auto& lut = kSrgbToLinear;
   const uint8_t* p = &srgb_[(size_t(y) * size_t(width_) + size_t(x)) * 3];
   return {lut[p[0]], lut[p[1]], lut[p[2]]};
 }
@@ -51,7 +49,8 @@ Vec3 Texture::bilinear(float u, float v) const {
   const float fy = (1.0f - (v - std::floor(v))) * float(height_) - 0.5f;
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
-  const auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  // fx lies in [-0.5, width - 0.5), so x0 in [-1, width - 1]: one compare wraps each side.
+  const auto wrap = [](int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); };
   const int x0 = wrap(int(x0f), width_), x1 = wrap(int(x0f) + 1, width_);
   const int y0 = wrap(int(y0f), height_), y1 = wrap(int(y0f) + 1, height_);
   return (texel(x0, y0) * (1.0f - ax) + texel(x1, y0) * ax) * (1.0f - ay) +
