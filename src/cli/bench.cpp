@@ -327,6 +327,10 @@ void add_bench_options(CLI::App& app, BenchArgs& a) {
   app.add_flag("--framed", a.framed, "also time each view's scene framed from outside its bounds, as a labelled row");
   app.add_option("--size", a.size, "image size WxH")->capture_default_str();
   app.add_option("--ao", a.ao, "AO rays per hit")->capture_default_str();
+  app.add_option("--integrator", a.integrator,
+                 "workload: " + names_of<Integrator>(kIntegratorNames) + " (ao: the study's; path: incoherent rays)")
+      ->capture_default_str();
+  app.add_option("--spp", a.spp, "path: samples per pixel (1-65536)")->capture_default_str();
   app.add_option("--runs", a.runs, "timed runs per cell")->capture_default_str();
   app.add_option("--best", a.best, "mean of the best k runs (the study's k-best rule)")->capture_default_str();
   app.add_option("--threads", a.threads, "threads for the parallel variants (default: all)");
@@ -347,6 +351,8 @@ int run_bench(const BenchArgs& a) {
   }
   const auto [width, height] = parse_size("--size", a.size);
   check_range("--ao", a.ao, 0, 4096);
+  check_range("--spp", a.spp, 1, 65536);
+  const Integrator integrator = parse_name<Integrator>(kIntegratorNames, a.integrator, "--integrator", "integrator");
   check_range("--runs", a.runs, 1, 1000);
   check_range("--best", a.best, 1, a.runs);
   if (a.threads) check_range("--threads", *a.threads, 1, 1024);
@@ -405,9 +411,12 @@ int run_bench(const BenchArgs& a) {
         rs.width = width;
         rs.height = height;
         rs.ao_samples = a.ao;
-        rs.packets = v.packets;
+        rs.integrator = integrator;
+        rs.spp = integrator == Integrator::Path ? a.spp : 1;
+        rs.packets = v.packets && integrator == Integrator::Ao;
         Framebuffer fb(width, height);
         RenderContext ctx{&scene, Camera(cam, width, height), rs, &fb};
+        ctx.samples = {0, uint32_t(rs.spp)};  // one pass: the timing has no pass overhead
         std::atomic<bool> stop{false};
         RenderControl control;
         control.cancel = &stop;
@@ -459,8 +468,11 @@ int run_bench(const BenchArgs& a) {
     }
   };
   const std::string timeout_text = "> " + fmt(a.max_seconds, 0) + " s";
-  md << "tracer bench: " << width << "x" << height << ", " << a.ao << " AO rays per hit, " << a.runs
-     << " runs, mean of best " << a.best << ", threads " << resolve_thread_count(threads) << "\n";
+  const std::string workload = integrator == Integrator::Ao        ? std::to_string(a.ao) + " AO rays per hit"
+                               : integrator == Integrator::Whitted ? std::string("whitted")
+                                                                   : "path, " + std::to_string(a.spp) + " spp";
+  md << "tracer bench: " << width << "x" << height << ", " << workload << ", " << a.runs << " runs, mean of best "
+     << a.best << ", threads " << resolve_thread_count(threads) << "\n";
   header("Build + render time, ms (k-best mean)");
   row([&](const SceneEntry&, const Variant&, const Cell& c) {
     return c.timed_out ? timeout_text : fmt(c.total_ms) + (c.capped(a.runs) ? "*" : "");

@@ -19,6 +19,8 @@ struct BenchArgs {
   bool framed = false;             // also each view's scene framed from outside
   std::string size = "256x256";
   int ao = RenderSettings{}.ao_samples;
+  std::string integrator{name_of<Integrator>(kIntegratorNames, Integrator::Ao)};  // the study's workload
+  int spp = 16;                                                                   // path: samples per pixel
   int runs = 10, best = 3;
   std::optional<int> threads;  // empty: all hardware threads
   double max_seconds = 10.0;   // per cell, all runs together
