@@ -69,7 +69,7 @@ cases=(
   "one allowed core (taskset -c 0), default threads|taskset -c 0 tracer render -q --width 32 --height 32 -o t.png|0"
   "--threads 64 on a smaller machine|tracer render --threads 64 -q --width 32 --height 32 -o t.png|0"
   "--spp 0|tracer render --integrator path --spp 0 -q|2"
-  "--spp without --integrator path|tracer render --spp 16 -q|2"
+  "--spp with --integrator ao|tracer render --integrator ao --spp 16 -q|2"
   "--env with a negative component|tracer render --integrator path --env 1,-1,1 -q|2"
   "--checkpoint 0|tracer render --integrator path --checkpoint 0 -q|2"
   "two materials name a missing texture|tracer render tex.obj --width 32 --height 32 -o t.png|0"

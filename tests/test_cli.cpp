@@ -42,8 +42,9 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ + "/empty.obj") << "# nothing\n";
     std::ofstream(dir_ + "/ok.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
     std::ofstream(dir_ + "/same.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
-    std::ofstream(dir_ + "/views.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\tnote\n"
-                                       << "tri\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\tthe triangle\n";
+    // Not called views.tsv: that name beside ok.obj would give plain renders of ok.obj its view.
+    std::ofstream(dir_ + "/tri-views.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\tnote\n"
+                                           << "tri\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\tthe triangle\n";
     std::ofstream(dir_ + "/badviews.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\n"
                                           << "tri\tok.obj\t0,0,3\t0,0\t0,1,0\t45\t0,0,2\n";
   }
@@ -90,7 +91,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render SAME", 1, "same.obj: all vertices coincide"},
       {"render --integrator foo", 2, "--integrator: unknown integrator 'foo'"},
       {"render --integrator path --spp 0", 2, "--spp: must be between 1 and 1048576, got 0"},
-      {"render --spp 16", 2, "--spp: only for --integrator path"},
+      {"render --integrator ao --spp 16", 2, "--spp: only for --integrator path"},
       {"render --integrator whitted --env 1,1,1", 2, "--env: only for --integrator path"},
       {"render --integrator path --env 1,-1,1", 2, "--env: each component must be in [0, 1e30], got '1,-1,1'"},
       {"render --integrator path --env 1,1", 2, "--env: expected three finite numbers"},
@@ -102,11 +103,11 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"bench --size 32x32x99junk", 2, "--size: expected WxH (two whole numbers), got '32x32x99junk'"},
       {"bench --size 99999999999x2", 2, "--size width: must be between 1 and 16384, got 99999999999"},
       {"bench --threads 0", 2, "--threads: must be between 1 and 1024, got 0"},
-      {"render --view nope --views VIEWS", 1, "views.tsv: no view called 'nope' (tri)"},
+      {"render --view nope --views VIEWS", 1, "tri-views.tsv: no view called 'nope' (tri)"},
       {"render --view tri --views BADVIEWS", 1,
        "badviews.tsv:2: look: expected x,y,z (three finite numbers), got '0,0'"},
       {"render RANGE --view tri --views VIEWS", 2, "--view: the view names its scene"},
-      {"bench --scenes nope --views VIEWS", 1, "views.tsv: no view called 'nope'"},
+      {"bench --scenes nope --views VIEWS", 1, "tri-views.tsv: no view called 'nope'"},
   };
   for (const CliCase& c : cases) {
     std::string args = c.args;
@@ -115,7 +116,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
                                     {"EMPTY", "empty.obj"},
                                     {"SAME", "same.obj"},
                                     {"BADVIEWS", "badviews.tsv"},
-                                    {"VIEWS", "views.tsv"}}) {
+                                    {"VIEWS", "tri-views.tsv"}}) {
       for (size_t p = args.find(key); p != std::string::npos; p = args.find(key))
         args.replace(p, std::string(key).size(), dir_ + "/" + file);
     }
@@ -160,7 +161,7 @@ TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("is also the -o image"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
-  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 6 --ao 2 -o " + dir_ +
+  r = test::run_tracer("render " + quoted_scene + " -q --integrator ao --width 8 --height 6 --ao 2 -o " + dir_ +
                        "/x.png --stats-json " + dir_ + "/s.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(dir_ + "/s.json");
@@ -189,18 +190,35 @@ TEST_F(Cli, PathStatsCountSamplesAndCheckpoints) {
   EXPECT_EQ(read_image(dir_ + "/p.png").width, 8);
 }
 
-TEST_F(Cli, SceneWithoutLightsIsLitByAWhiteEnvironmentWithANote) {
+TEST_F(Cli, SceneWithoutEmittersIsLitByAWhiteSkyWithANote) {
   const auto r = test::run_tracer("render " + dir_ + "/ok.obj --integrator path --spp 2 --width 8 --height 8 -o " +
                                   dir_ + "/e.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("tracer: note: "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("(--env 1,1,1)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(--env 1,1,1; --env 0,0,0 for none)"), std::string::npos) << r.output;
   EXPECT_EQ(count_lines(r.output), 1) << r.output;
-  // The same with a light says nothing.
+  // Given an environment, nothing to say.
   const auto lit = test::run_tracer("render " + dir_ + "/ok.obj --integrator path --spp 2 --width 8 --height 8 " +
-                                    "--light 0,0,5 -o " + dir_ + "/e.png");
+                                    "--light 0,0,5 --env 0,0,0 -o " + dir_ + "/e.png");
   ASSERT_EQ(lit.exit_code, 0) << lit.output;
   EXPECT_EQ(lit.output, "");
+}
+
+TEST_F(Cli, ASceneWithoutLightsTakesItsViewFromAViewsFileBesideIt) {
+  // ok.obj has no emitter; a views.tsv beside it names it: a plain render uses that view's camera
+  // and light, says so, and gives the image --view gives. Standard input has no "beside".
+  fs::copy_file(dir_ + "/tri-views.tsv", dir_ + "/views.tsv");
+  const std::string flags = " --integrator ao --width 24 --height 16 -o ";
+  auto r = test::run_tracer("render " + dir_ + "/ok.obj" + flags + dir_ + "/plain.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("has no light of its own: using its view 'tri' (camera and light)"), std::string::npos)
+      << r.output;
+  r = test::run_tracer("render --view tri --views " + dir_ + "/views.tsv -q" + flags + dir_ + "/view.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/plain.png").rgb, read_image(dir_ + "/view.png").rgb);
+  r = test::run_tracer("render - -q" + flags + dir_ + "/stdin.png < " + dir_ + "/ok.obj");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(read_image(dir_ + "/stdin.png").rgb, read_image(dir_ + "/view.png").rgb);
 }
 
 TEST_F(Cli, CtrlCDuringAPathRenderWritesTheSamplesSoFar) {
@@ -254,8 +272,8 @@ TEST_F(Cli, OneAllowedCoreRunsOneThreadWithoutWarnings) {
 
 TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
   // The view's camera and light, against the same given as flags: the same image.
-  auto r = test::run_tracer("render --view tri --views " + dir_ + "/views.tsv -q --width 24 --height 16 -o " + dir_ +
-                            "/v.png");
+  auto r = test::run_tracer("render --view tri --views " + dir_ + "/tri-views.tsv -q --width 24 --height 16 -o " +
+                            dir_ + "/v.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = test::run_tracer("render " + dir_ +
                        "/ok.obj --eye 0,0,3 --look 0,0,0 --fov 45 --no-scene-lights --light 0,0,2 -q " +
@@ -264,7 +282,7 @@ TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
   EXPECT_EQ(read_image(dir_ + "/v.png").rgb, read_image(dir_ + "/f.png").rgb);
   // bench times a view and, with --framed, the same scene framed from outside as its own row.
   r = test::run_tracer("bench --scenes tri --views " + dir_ +
-                       "/views.tsv --framed --variants sah --size 8x8 --runs 1 --best 1");
+                       "/tri-views.tsv --framed --variants sah --size 8x8 --runs 1 --best 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("| Tri | 1 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("| Tri (framed) | 1 |"), std::string::npos) << r.output;
@@ -273,7 +291,7 @@ TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
 TEST_F(Cli, DefaultIsTheFastestPathWithTheScalarImage) {
   // No flags: the 8-wide BVH with packets and bundles; the same image as the scalar binary BVH
   // tracing every ray alone. --simd off alone asks for that scalar tree.
-  const std::string common = " -q --width 24 --height 20 --ao 4";
+  const std::string common = " -q --integrator ao --width 24 --height 20 --ao 4";
   auto r = test::run_tracer("render" + common + " --stats-json " + dir_ + "/d.json -o " + dir_ + "/d.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(dir_ + "/d.json");
@@ -304,8 +322,9 @@ TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {
 
 TEST_F(Cli, RendersPngPpmAndStats) {
   const std::string scene = dir_ + "/ok.obj";
-  auto r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --stats --stats-json " + dir_ +
-                            "/s.json -o " + dir_ + "/a.png");
+  auto r =
+      test::run_tracer("render " + scene + " -q --integrator ao --width 16 --height 12 --ao 2 --stats --stats-json " +
+                       dir_ + "/s.json -o " + dir_ + "/a.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Mrays/s"), std::string::npos);
   const Image8 png = read_image(dir_ + "/a.png");
@@ -315,13 +334,14 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   const std::string text((std::istreambuf_iterator<char>(json)), {});
   EXPECT_NE(text.find("\"primary\": 192"), std::string::npos) << text;
   EXPECT_NE(text.find("\"mrays_per_s\""), std::string::npos);
-  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 -o " + dir_ + "/a.ppm");
+  r = test::run_tracer("render " + scene + " -q --integrator ao --width 16 --height 12 --ao 2 -o " + dir_ + "/a.ppm");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Image8 ppm = read_image(dir_ + "/a.ppm");
   EXPECT_EQ(ppm.rgb, png.rgb);  // same render, two containers
   // The 8-wide BVH with primary-ray packets: the same image, every primary ray counted once.
-  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --accel bvh8 --packets --stats-json " +
-                       dir_ + "/p.json -o " + dir_ + "/p.png");
+  r = test::run_tracer("render " + scene +
+                       " -q --integrator ao --width 16 --height 12 --ao 2 --accel bvh8 --packets --stats-json " + dir_ +
+                       "/p.json -o " + dir_ + "/p.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_image(dir_ + "/p.png").rgb, png.rgb);
   std::ifstream pjson(dir_ + "/p.json");
@@ -329,7 +349,8 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   EXPECT_NE(ptext.find("\"packets\": true"), std::string::npos) << ptext;
   EXPECT_NE(ptext.find("\"primary\": 192"), std::string::npos) << ptext;
   // The binary BVH with AO bundles: the same image.
-  r = test::run_tracer("render " + scene + " -q --width 16 --height 12 --ao 2 --packets -o " + dir_ + "/b.png");
+  r = test::run_tracer("render " + scene + " -q --integrator ao --width 16 --height 12 --ao 2 --packets -o " + dir_ +
+                       "/b.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_image(dir_ + "/b.png").rgb, png.rgb);
   r = test::run_tracer("info " + scene);

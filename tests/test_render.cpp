@@ -106,18 +106,19 @@ void expect_golden(const std::string& scene, const std::string& flags, const std
 
 std::string cornell(const std::string& name) { return test::scene_path("cornell-box/CornellBox-" + name + ".obj"); }
 
-// Golden images: 96x96, default settings (16 AO rays), made with
-//   tracer render ../shared/scenes/cornell-box/CornellBox-X.obj --width 96 --height 96
-//     --accel brute --sched seq -o tests/golden/X.png
+// Golden images: 96x96, the study's workload with its default settings (16 AO rays), made with
+//   tracer render ../shared/scenes/cornell-box/CornellBox-X.obj --integrator ao --width 96
+//     --height 96 --accel brute --sched seq -o tests/golden/X.png
 // (and with no scene for builtin.png), then looked at. The test renders through the default
 // path and requires the same bytes: every accelerator, SIMD target, scheduler and thread count
 // computes the same floats (tested elsewhere), so the study's workload is byte-identical to its
 // golden images. The tolerance is zero; only a different libm (another platform's exp/pow/sin)
 // could move a pixel, and then PSNR says how far.
 TEST(Render, GoldenImages) {
-  expect_golden("", "", "builtin");
+  expect_golden("", "--integrator ao", "builtin");
   if (!test::have_shared_scenes()) return;
-  for (const char* name : {"Original", "Mirror", "Sphere", "Water"}) expect_golden(cornell(name), "", name);
+  for (const char* name : {"Original", "Mirror", "Sphere", "Water"})
+    expect_golden(cornell(name), "--integrator ao", name);
 }
 
 // Whitted reference images: 96x96, made with

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 
 #include "base/errors.hpp"
 #include "cli/parse.hpp"
@@ -185,6 +186,19 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
     return scene;
   }
   Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel);
+  // A scene with no light of its own (Sponza, Sibenik, the Bunny) that a views.tsv beside it
+  // knows: its view's camera, and its light unless --light gives one, so a plain render shows it
+  // as the views mean it (from inside, lit) rather than framed from outside in the dark.
+  if (!a.scene.empty() && a.scene != "-" && scene.lights.empty()) {
+    if (const std::optional<View> view = view_of_scene_file(a.scene)) {
+      if (a.lights.empty()) apply_view_light(scene, *view);
+      scene.camera = view->camera;
+      if (!quiet) {
+        std::cerr << "tracer: note: " << a.scene << " has no light of its own: using its view '" << view->name
+                  << (a.lights.empty() ? "' (camera and light)\n" : "' (camera)\n");
+      }
+    }
+  }
   add_lights(scene, a);
   return scene;
 }
@@ -238,11 +252,10 @@ RenderSettings settings_for(const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
   RenderSettings s = settings_for(a);
   note.clear();
-  const bool point_lights =
-      std::any_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return l.is_point(); });
-  if (s.integrator == Integrator::Path && a.env.empty() && scene.emitters.empty() && !point_lights) {
+  if (s.integrator == Integrator::Path && a.env.empty() && scene.emitters.empty()) {
     s.environment = Vec3{1.0f};
-    note = scene.source + " has no emissive material and no --light: lit by a uniform white environment (--env 1,1,1)";
+    note = scene.source +
+           " has no emissive surface: a uniform white sky lights it too (--env 1,1,1; --env 0,0,0 for none)";
   }
   return s;
 }

@@ -41,7 +41,9 @@ struct RenderArgs {
   std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
   std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
   std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};
-  std::string integrator{name_of<Integrator>(kIntegratorNames, RenderSettings{}.integrator)};
+  // path for a user's render (every material, soft shadows, indirect light); the library's
+  // default, and bench's, stays the study's ao.
+  std::string integrator{name_of<Integrator>(kIntegratorNames, Integrator::Path)};
   std::string simd = "auto";
   std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
   std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
@@ -67,8 +69,9 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
 inline constexpr int kDefaultPathSpp = 64;
-// settings_for() plus what depends on the scene: a path render of a scene with no emitter, no
-// point light and no --env gets a uniform white environment, and `note` says so.
+// settings_for() plus what depends on the scene: a path render of a scene with no emissive
+// surface and no --env is lit by a uniform white sky as well as any point lights (a point light
+// alone leaves everything it does not see black), and `note` says so.
 RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
 AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);

@@ -53,6 +53,25 @@ std::string default_views_path() {
   return "../shared/scenes/views.tsv";
 }
 
+std::optional<View> view_of_scene_file(const std::string& obj_path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = fs::path(obj_path).parent_path();
+  for (const fs::path& candidate : {dir / "views.tsv", dir / ".." / "views.tsv"}) {
+    if (!fs::is_regular_file(candidate, ec)) continue;
+    std::vector<View> views;
+    try {
+      views = load_views(candidate.string());
+    } catch (const InputError&) {
+      continue;
+    }
+    for (const View& v : views) {
+      if (fs::equivalent(v.obj, obj_path, ec)) return v;
+    }
+  }
+  return std::nullopt;
+}
+
 std::vector<View> load_views(const std::string& path) {
   std::string text = read_input(path);
   strip_bom(text);

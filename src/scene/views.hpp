@@ -4,6 +4,7 @@
 // them.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct View {
 // ../shared/scenes/views.tsv, looked for from the current directory and up to two levels below
 // the project root (a build directory); that path even when it does not exist.
 std::string default_views_path();
+
+// The view a views.tsv beside the scene (in its directory or the one above) gives for the file
+// at `obj_path`, if any; a views file that cannot be read or parsed counts as none.
+std::optional<View> view_of_scene_file(const std::string& obj_path);
 
 // Reads a views file: a header line (scene, obj, eye, look, up, fov, light, note), then one view
 // per line, fields separated by tabs, vectors as x,y,z. Throws InputError naming file:line.
