@@ -215,13 +215,15 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
     next = {n.child[near], n.count[near], t[near]};
     return true;
   }
-  StackEntry hits[kWideWidth];
+  // Sorted in place on top of the stack (a local array copied over afterwards compiled to a
+  // rep movs, 3 % of a path render's time in Sponza).
+  StackEntry* hits = stack + sp;
   int k = 0;
   bits |= (1u << i) | (1u << j);
   while (bits) {
     const int c = __builtin_ctz(bits);
     bits &= bits - 1;
-    StackEntry e{n.child[c], n.count[c], t[c]};
+    const StackEntry e{n.child[c], n.count[c], t[c]};
     int m = k++;
     while (m > 0 && hits[m - 1].t < e.t) {  // descending: farthest first
       hits[m] = hits[m - 1];
@@ -229,8 +231,8 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
     }
     hits[m] = e;
   }
-  for (int c = 0; c < k - 1; ++c) stack[sp++] = hits[c];
   next = hits[k - 1];
+  sp += k - 1;
   return true;
 }
 
