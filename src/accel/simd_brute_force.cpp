@@ -21,15 +21,14 @@ bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
   hit = Hit{};
   hit.t = ray.tfar;
   const RayShear shear(ray);
-  const Triangle* tris = bf.triangles().data();
-  const uint32_t* ids = bf.triangle_ids().data();
-  for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ids, ray.tnear, hit);
+  const Triangle* tris = bf.scene().triangles.data();
+  for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ray.tnear, hit);
   return finish_hit(bf.scene(), hit);
 }
 
 bool OccludedBrute(const SimdBruteForce& bf, const Ray& ray) {
   const RayShear shear(ray);
-  const Triangle* tris = bf.triangles().data();
+  const Triangle* tris = bf.scene().triangles.data();
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
   for (const TrianglePack& p : bf.packs()) {
     if (IntersectPack(p, shear, tris, ray.tnear, ray.tfar, tt, uu, vv)) return true;
@@ -53,13 +52,16 @@ bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const {
 bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
 
 SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
+  std::vector<Triangle> tris;
+  std::vector<uint32_t> ids;
   for (uint32_t i = 0; i < scene.size(); ++i) {
     if (scene.triangles[i].degenerate()) continue;
-    tris_.push_back(scene.triangles[i]);
-    ids_.push_back(i);
+    tris.push_back(scene.triangles[i]);
+    ids.push_back(i);
   }
-  for (uint32_t first = 0; first < tris_.size(); first += kWideWidth) {
-    packs_.push_back(make_triangle_pack(tris_, first, std::min<uint32_t>(kWideWidth, uint32_t(tris_.size()) - first)));
+  for (uint32_t first = 0; first < tris.size(); first += kWideWidth) {
+    packs_.push_back(
+        make_triangle_pack(tris, ids, first, std::min<uint32_t>(kWideWidth, uint32_t(tris.size()) - first)));
   }
 }
 

@@ -5,7 +5,8 @@
 
 namespace tracer {
 
-TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t first, uint32_t count) {
+TrianglePack make_triangle_pack(std::span<const Triangle> triangles, std::span<const uint32_t> ids, uint32_t first,
+                                uint32_t count) {
   TrianglePack p;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int lane = 0; lane < kWideWidth; ++lane) {
@@ -15,7 +16,7 @@ TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t fi
     for (int vtx = 0; vtx < 3; ++vtx) {
       for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = used ? vs[vtx][axis] : nan;
     }
-    p.slot[lane] = used ? first + uint32_t(lane) : kInvalidIndex;
+    p.id[lane] = used ? ids[first + uint32_t(lane)] : kInvalidIndex;
   }
   return p;
 }

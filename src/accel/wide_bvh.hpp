@@ -35,7 +35,10 @@ static_assert(sizeof(WideNode) == 256);
 // Unused lanes hold NaN vertices, which fail every comparison and so never hit.
 struct alignas(64) TrianglePack {
   float v[3][3][kWideWidth];  // [vertex][axis][lane]
-  uint32_t slot[kWideWidth];  // index into triangles()/triangle_ids(), or kInvalidIndex for padding
+  // The scene triangle in each lane (its index in Scene::triangles, which the exact-edge fallback
+  // and the any-hit bundles read), or kInvalidIndex for padding: a hit names its triangle with
+  // no further lookup.
+  uint32_t id[kWideWidth];
 };
 
 class WideBvh {
@@ -57,8 +60,6 @@ class WideBvh {
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const std::vector<TrianglePack>& packs() const { return packs_; }
-  const TriangleArray& triangles() const { return tris_; }
-  const std::vector<uint32_t>& triangle_ids() const { return ids_; }
   // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kInvalidIndex.
   const std::vector<uint32_t>& node_places() const { return node_place_; }
   // The node and slot of the leaf holding each scene triangle (kInvalidIndex: degenerate, in no leaf).
@@ -66,8 +67,8 @@ class WideBvh {
   static constexpr uint32_t place(uint32_t node, uint32_t slot) { return node * kWideWidth + slot; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const {
-    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) +
-           (ids_.size() + node_place_.size() + leaf_place_.size()) * sizeof(uint32_t);
+    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) +
+           (node_place_.size() + leaf_place_.size()) * sizeof(uint32_t);
   }
   // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf.
   std::string validate() const;
@@ -85,8 +86,6 @@ class WideBvh {
   const Scene* scene_;
   std::vector<WideNode> nodes_;
   std::vector<TrianglePack> packs_;
-  TriangleArray tris_;
-  std::vector<uint32_t> ids_;
   std::vector<uint32_t> node_place_, leaf_place_;
   Aabb bounds_;
 };
@@ -99,22 +98,17 @@ class SimdBruteForce {
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
   const std::vector<TrianglePack>& packs() const { return packs_; }
-  const std::vector<Triangle>& triangles() const { return tris_; }
-  const std::vector<uint32_t>& triangle_ids() const { return ids_; }
   const Scene& scene() const { return *scene_; }
-  size_t memory_bytes() const {
-    return packs_.size() * sizeof(TrianglePack) + tris_.size() * sizeof(Triangle) + ids_.size() * sizeof(uint32_t);
-  }
+  size_t memory_bytes() const { return packs_.size() * sizeof(TrianglePack); }
 
  private:
   const Scene* scene_;
   std::vector<TrianglePack> packs_;
-  std::vector<Triangle> tris_;
-  std::vector<uint32_t> ids_;
 };
 
-// Packs triangles[first, first+count) (count <= 8) into one TrianglePack; `slot` indices are
-// first + lane, padding lanes are NaN.
-TrianglePack make_triangle_pack(std::span<const Triangle> triangles, uint32_t first, uint32_t count);
+// Packs triangles[first, first+count) (count <= 8) into one TrianglePack; lane k's id is
+// ids[first + k], padding lanes are NaN.
+TrianglePack make_triangle_pack(std::span<const Triangle> triangles, std::span<const uint32_t> ids, uint32_t first,
+                                uint32_t count);
 
 }  // namespace tracer

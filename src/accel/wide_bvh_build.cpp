@@ -86,7 +86,7 @@ class Collapser {
   bool packable(uint32_t node) const { return count_[node] <= uint32_t(kWideWidth); }
 
   uint32_t make_pack(uint32_t first, uint32_t count) {
-    packs_.push_back(make_triangle_pack(bin_.triangles(), first, count));
+    packs_.push_back(make_triangle_pack(bin_.triangles(), bin_.triangle_ids(), first, count));
     return static_cast<uint32_t>(packs_.size() - 1);
   }
 
@@ -102,8 +102,6 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_
   BvhBuildOptions options = options_in;
   options.max_leaf = std::min(options.max_leaf, kWideWidth);
   const Bvh binary(scene, options);
-  tris_ = binary.triangles();
-  ids_ = binary.triangle_ids();
   if (binary.nodes().empty()) return;
   nodes_.reserve(binary.nodes().size() / 4 + 1);
   Collapser(binary, nodes_, packs_).collapse(0);
@@ -116,7 +114,7 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_
     for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
       if (n.count[c] > 0) {
         const TrianglePack& pack = packs_[n.child[c]];
-        for (uint32_t lane = 0; lane < n.count[c]; ++lane) leaf_place_[ids_[pack.slot[lane]]] = place(w, c);
+        for (uint32_t lane = 0; lane < n.count[c]; ++lane) leaf_place_[pack.id[lane]] = place(w, c);
       } else if (n.child[c] != 0) {  // child 0 is the root: an empty slot
         node_place_[n.child[c]] = place(w, c);
       }

@@ -46,7 +46,7 @@ HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t coun
     const Vec3 v0{pack.v[0][0][k], pack.v[0][1][k], pack.v[0][2][k]};
     const Vec3 v1{pack.v[1][0][k], pack.v[1][1][k], pack.v[1][2][k]};
     const Vec3 v2{pack.v[2][0][k], pack.v[2][1][k], pack.v[2][2][k]};
-    const uint32_t hit = OccludedByTriangle(v0, v1, v2, tris[pack.slot[k]], st, mask);
+    const uint32_t hit = OccludedByTriangle(v0, v1, v2, tris[pack.id[k]], st, mask);
     found |= hit;
     mask &= ~hit;
   }
@@ -71,7 +71,7 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
   const float hi[3] = {bvh.bounds().hi.x, bvh.bounds().hi.y, bvh.bounds().hi.z};
   uint32_t active = TestBundleBox(lo, hi, st, rays.active);
   if (active == 0) return 0;
-  const Triangle* tris = bvh.triangles().data();
+  const Triangle* tris = bvh.scene().triangles.data();
   const TrianglePack* packs = bvh.packs().data();
   uint32_t occluded = 0;
 

@@ -134,10 +134,10 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
     while (edge) {  // exactly on an edge in float: let the scalar test decide in double
       const int k = __builtin_ctz(edge);
       edge &= edge - 1;
-      const uint32_t slot = p.slot[i + size_t(k)];
+      const uint32_t id = p.id[i + size_t(k)];
       TriangleHit th;
       h &= ~(1u << k);
-      if (slot != kInvalidIndex && intersect_triangle(s, tris[slot], tnear, tfar, th)) {
+      if (id != kInvalidIndex && intersect_triangle(s, tris[id], tnear, tfar, th)) {
         h |= 1u << k;
         t_out[i + size_t(k)] = th.t;
         u_out[i + size_t(k)] = th.u;
@@ -152,8 +152,8 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
 // Updates `hit` with the closest lane of `pack` (ties to the lower scene index, as everywhere).
 // The nearest of several hit lanes is found by a SIMD minimum over the lanes, not a loop; only
 // lanes tied exactly at that minimum (rare) are compared one by one for the lower index.
-HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, const uint32_t* ids,
-                              float tnear, Hit& hit) {
+HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, float tnear,
+                              Hit& hit) {
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
   const uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv);
   if (bits == 0) return;
@@ -179,7 +179,7 @@ HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, cons
   }
   for (; nearest; nearest &= nearest - 1) {  // one lane, unless several tie exactly
     const int k = __builtin_ctz(nearest);
-    const uint32_t id = ids[p.slot[k]];
+    const uint32_t id = p.id[k];
     if (closer(tt[k], id, hit)) {
       hit.t = tt[k];
       hit.u = uu[k];
@@ -240,7 +240,7 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
 HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar,
                               StackEntry start) {
   const WideNode* nodes = bvh.nodes().data();
-  const Triangle* tris = bvh.triangles().data();
+  const Triangle* tris = bvh.scene().triangles.data();
   const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;

@@ -85,13 +85,13 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
 
 // Triangle `k` of `pack` against the lanes in `mask`, updating each lane's closest hit exactly
 // as intersect_range() does for one ray.
-HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, const uint32_t* ids,
-                                        PacketState& st, uint32_t mask) {
+HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, PacketState& st,
+                                        uint32_t mask) {
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
-  const uint32_t slot = p.slot[k];
-  const int32_t id = int32_t(ids[slot] ^ uint32_t(kFlip));
+  const uint32_t tri = p.id[k];
+  const int32_t id = int32_t(tri ^ uint32_t(kFlip));
   const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
   const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
   const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
@@ -140,7 +140,7 @@ HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Tria
       h.t = st.t[lane];
       h.tri = best_tri;
       TriangleHit th;
-      if (intersect_triangle(shear, tris[slot], st.tnear[lane], h.t, th) && closer(th.t, ids[slot], h)) {
+      if (intersect_triangle(shear, tris[tri], st.tnear[lane], h.t, th) && closer(th.t, tri, h)) {
         st.t[lane] = th.t;
         st.u[lane] = th.u;
         st.v[lane] = th.v;
@@ -216,8 +216,7 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
 
   const WideNode* nodes = bvh.nodes().data();
   const TrianglePack* packs = bvh.packs().data();
-  const Triangle* tris = bvh.triangles().data();
-  const uint32_t* ids = bvh.triangle_ids().data();
+  const Triangle* tris = bvh.scene().triangles.data();
   PacketEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
   PacketEntry cur{0, 0, active, 0.0f};
@@ -247,7 +246,7 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
       }
     } else {
       const TrianglePack& p = packs[cur.child];
-      for (uint32_t k = 0; k < cur.count; ++k) IntersectTrianglePacket(p, int(k), tris, ids, st, cur.lanes);
+      for (uint32_t k = 0; k < cur.count; ++k) IntersectTrianglePacket(p, int(k), tris, st, cur.lanes);
     }
     if (sp == 0) break;
     cur = stack[--sp];

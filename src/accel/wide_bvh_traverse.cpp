@@ -19,8 +19,7 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   if (nodes.empty()) return false;
   const WideRay wr(ray);
   const RayShear shear(ray);
-  const Triangle* tris = bvh.triangles().data();
-  const uint32_t* ids = bvh.triangle_ids().data();
+  const Triangle* tris = bvh.scene().triangles.data();
   const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
@@ -31,7 +30,7 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
       const WideNode& n = nodes[cur.child];
       if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
     } else {
-      ClosestInPack(packs[cur.child], shear, tris, ids, ray.tnear, hit);
+      ClosestInPack(packs[cur.child], shear, tris, ray.tnear, hit);
     }
     // Pop, skipping entries now beyond the closest hit (<=: ties still count).
     do {

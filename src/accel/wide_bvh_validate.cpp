@@ -9,7 +9,12 @@
 namespace tracer {
 
 std::string WideBvh::validate() const {
-  if (nodes_.empty()) return tris_.empty() ? "" : "triangles but no nodes";
+  if (nodes_.empty()) {
+    for (const Triangle& t : scene_->triangles) {
+      if (!t.degenerate()) return "triangles but no nodes";
+    }
+    return "";
+  }
   std::vector<uint32_t> seen(scene_->size(), 0);
   std::vector<uint32_t> visits(nodes_.size(), 0);
   std::vector<uint32_t> stack{0};
@@ -37,18 +42,18 @@ std::string WideBvh::validate() const {
         const TrianglePack& pk = packs_[n.child[i]];
         for (uint32_t lane = 0; lane < uint32_t(kWideWidth); ++lane) {
           if (lane >= n.count[i]) {
-            if (pk.slot[lane] != kInvalidIndex || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
+            if (pk.id[lane] != kInvalidIndex || !std::isnan(pk.v[0][0][lane])) return "padding lane not empty";
             continue;
           }
-          const uint32_t k = pk.slot[lane];
-          if (k >= tris_.size()) return "pack slot out of range";
-          const Triangle& t = tris_[k];
+          const uint32_t k = pk.id[lane];
+          if (k >= scene_->size()) return "pack lane's triangle out of range";
+          const Triangle& t = scene_->triangles[k];
           if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
-          if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(ids_[k]);
-          if (leaf_place_.size() != seen.size() || leaf_place_[ids_[k]] != place(p.node, uint32_t(i))) {
-            return "leaf place of triangle " + std::to_string(ids_[k]) + " is wrong";
+          if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(k);
+          if (leaf_place_.size() != seen.size() || leaf_place_[k] != place(p.node, uint32_t(i))) {
+            return "leaf place of triangle " + std::to_string(k) + " is wrong";
           }
-          ++seen[ids_[k]];
+          ++seen[k];
         }
       } else {
         if (n.child[i] >= node_place_.size() || node_place_[n.child[i]] != place(p.node, uint32_t(i))) {
