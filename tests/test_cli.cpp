@@ -235,6 +235,37 @@ TEST_F(Cli, CtrlCDuringAPathRenderWritesTheSamplesSoFar) {
   EXPECT_EQ(img.height, 48);
 }
 
+TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
+  const std::string d = dir_ + "/";
+  ASSERT_EQ(test::run_tracer("render -q --integrator path --spp 4 --width 8 --height 8 -o " + d + "a.exr").exit_code,
+            0);
+  ASSERT_EQ(
+      test::run_tracer("render -q --integrator path --spp 4 --seed 1 --width 8 --height 8 -o " + d + "b.exr").exit_code,
+      0);
+  ASSERT_EQ(test::run_tracer("render -q --integrator path --spp 4 --width 8 --height 6 -o " + d + "c.exr").exit_code,
+            0);
+  ASSERT_EQ(test::run_tracer("render -q --integrator ao --width 8 --height 8 -o " + d + "a.png").exit_code, 0);
+  auto r = test::run_tracer("compare " + d + "a.exr " + d + "a.exr");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("8x8, linear radiance: RMSE 0,"), std::string::npos) << r.output;
+  r = test::run_tracer("compare " + d + "a.exr " + d + "b.exr");  // another seed: noise, not zero
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("RMSE 0,"), std::string::npos) << r.output;
+  r = test::run_tracer("compare " + d + "a.png " + d + "a.png");
+  EXPECT_NE(r.output.find("PSNR inf dB"), std::string::npos) << r.output;
+  for (const auto& [args, code, message] :
+       {std::tuple{"a.exr c.exr", 2, "compare: sizes differ (8x8 and 8x6)"},
+        std::tuple{"a.exr a.png", 2, "compare: both images must be EXR (linear) or both PNG/PPM (display)"},
+        std::tuple{"a.exr none.exr", 1, "none.exr: cannot read EXR"}}) {
+    std::string a = args;
+    a.insert(a.find(' ') + 1, d);
+    r = test::run_tracer("compare " + d + a);
+    EXPECT_EQ(r.exit_code, code) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  }
+}
+
 TEST_F(Cli, BenchJsonParsesBack) {
   const auto r = test::run_tracer(
       "bench --scenes builtin --variants sah,bvh8 --size 8x8 --ao 1 --runs 1 --best 1 --json " + dir_ + "/b.json");

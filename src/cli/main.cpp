@@ -15,6 +15,7 @@
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
 #include "cli/signals.hpp"
+#include "io/image_compare.hpp"
 #include "io/image_io.hpp"
 
 namespace tracer::cli {
@@ -186,6 +187,15 @@ int cmd_info(const SceneArgs& args) {
   return 0;
 }
 
+int cmd_compare(const std::string& a, const std::string& b) {
+  const ImageDifference d = compare_images(a, b);
+  std::printf("%dx%d, %s: RMSE %.6g, largest difference %.6g", d.width, d.height,
+              d.linear ? "linear radiance" : "display values 0-1", d.rmse, d.max_abs);
+  if (!d.linear) std::printf(", PSNR %.2f dB", d.psnr_db);
+  std::printf("\n");
+  return 0;
+}
+
 }  // namespace
 }  // namespace tracer::cli
 
@@ -213,6 +223,12 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");
   add_scene_options(*info, info_args);
 
+  std::string compare_a, compare_b;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "RMSE between two images: linear radiance for two .exr, display values (and PSNR) for .png/.ppm");
+  compare->add_option("a", compare_a, "an image (e.g. the reference)")->required();
+  compare->add_option("b", compare_b, "an image of the same size and kind")->required();
+
   BenchArgs bench_args;
   CLI::App* bench = app.add_subcommand("bench", "time the study's variants and ours on the Cornell scenes and more");
   add_bench_options(*bench, bench_args);
@@ -222,7 +238,7 @@ int main(int argc, char** argv) {
     try {
       app.get_subcommand(argv[1]);
     } catch (const CLI::OptionNotFound&) {
-      std::cerr << "tracer: error: unknown command '" << argv[1] << "' (render, info, bench)\n";
+      std::cerr << "tracer: error: unknown command '" << argv[1] << "' (render, info, bench, compare)\n";
       return 2;
     }
   }
@@ -237,6 +253,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return cmd_render(render_args);
     if (info->parsed()) return cmd_info(info_args);
     if (bench->parsed()) return run_bench(bench_args);
+    if (compare->parsed()) return cmd_compare(compare_a, compare_b);
   } catch (const UsageError& e) {
     std::cerr << "tracer: error: " << e.what() << "\n";
     return 2;
