@@ -125,9 +125,8 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
 }
 
 // A path-traced image's raw sums (not only its 8-bit rendering), rendered in the passes of
-// sample_passes() or, with one_pass, all samples in one pass.
-std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size,
-                             bool one_pass) {
+// sample_passes().
+std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size) {
   RenderSettings s;
   s.width = size;
   s.height = size * 3 / 4 + 1;
@@ -137,12 +136,7 @@ std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const S
   const CameraSpec cam = scene.camera ? *scene.camera : CameraSpec{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
   RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
   RenderControl control;
-  if (one_pass) {
-    ctx.samples = {0, uint32_t(s.spp)};
-    EXPECT_TRUE(render_image(acc, ctx, so, control));
-  } else {
-    EXPECT_TRUE(render_passes(acc, ctx, so, control));
-  }
+  EXPECT_TRUE(render_passes(acc, ctx, so, control));
   EXPECT_EQ(fb.min_samples(), uint32_t(s.spp));
   std::vector<float> sums;
   for (size_t i = 0; i < fb.pixel_count(); ++i) {
@@ -151,30 +145,30 @@ std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const S
   return sums;
 }
 
-TEST(Sched, PathImagesIdenticalAcrossSchedulersThreadsTilesPassesAndAccelerators) {
-  // The random numbers are a function of (pixel, sample, bounce) and each pixel adds its samples
-  // in order, so every float of the sums is the same however the work was cut.
+TEST(Sched, PathImagesIdenticalAcrossSchedulersThreadsTilesAndAccelerators) {
+  // The random numbers are a function of (pixel, sample, bounce), each pass adds each pixel's
+  // sum of its samples, and passes are added in order: every float of the sums is the same
+  // however the work was cut.
   const int size = int(test::ray_budget(100'000) >= 100'000 ? 24 : 12);
   for (const Scene& scene : scenes()) {
     SCOPED_TRACE(scene.source);
     const Accelerator bvh = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     SchedOptions seq;
     seq.kind = SchedKind::Seq;
-    const std::vector<float> reference = path_sums(scene, bvh, seq, size, true);
-    EXPECT_EQ(path_sums(scene, bvh, seq, size, false), reference) << "passes";
+    const std::vector<float> reference = path_sums(scene, bvh, seq, size);
     for (SchedKind kind : {SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
       SchedOptions so;
       so.kind = kind;
       so.threads = 3;
       so.tile = 5;
       so.block = 17;
-      EXPECT_EQ(path_sums(scene, bvh, so, size, false), reference) << name_of<SchedKind>(kSchedKindNames, kind);
+      EXPECT_EQ(path_sums(scene, bvh, so, size), reference) << name_of<SchedKind>(kSchedKindNames, kind);
     }
     for (AccelKind kind : {AccelKind::Bvh8, AccelKind::BruteSimd}) {
       SchedOptions so;
       so.kind = SchedKind::Tbb;
       so.threads = 2;
-      EXPECT_EQ(path_sums(scene, build_accelerator(scene, AccelOptions{.kind = kind}), so, size, false), reference)
+      EXPECT_EQ(path_sums(scene, build_accelerator(scene, AccelOptions{.kind = kind}), so, size), reference)
           << name_of<AccelKind>(kAccelKindNames, kind);
     }
   }

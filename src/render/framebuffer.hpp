@@ -1,13 +1,14 @@
 // Linear-radiance framebuffer: per pixel the sum of the samples taken so far and their count, so
 // passes add up (progressive renders, ranks of an MPI job) and any prefix of them is an image.
-// Each pixel's samples are added in sample order, so the sums are the same however the passes,
-// tiles and threads were cut.
+// A pass adds each pixel's sum of its samples (summed in sample order from zero), and passes are
+// added in order: the floats depend on the pass schedule only, not on who rendered which tile.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "math/vec.hpp"
+#include "parallel/tiles.hpp"
 
 namespace tracer {
 
@@ -15,15 +16,21 @@ class Framebuffer {
  public:
   Framebuffer(int width, int height)
       : width_(width), height_(height), sum_(size_t(width) * size_t(height)), samples_(sum_.size(), 0u) {}
+  // A framebuffer for one window of a larger image (a tile a rank renders for another): pixels
+  // keep the image's coordinates, x in [window.x0, window.x1).
+  explicit Framebuffer(const Tile& window) : Framebuffer(window.x1 - window.x0, window.y1 - window.y0) {
+    x0_ = window.x0;
+    y0_ = window.y0;
+  }
   int width() const { return width_; }
   int height() const { return height_; }
   size_t pixel_count() const { return sum_.size(); }
 
-  // Adds one sample to pixel (x, y).
-  void add(int x, int y, Vec3 sample) {
+  // Adds to pixel (x, y) the sum of `count` samples (one sample by default).
+  void add(int x, int y, Vec3 sum, uint32_t count = 1) {
     const size_t i = index(x, y);
-    sum_[i] += sample;
-    ++samples_[i];
+    sum_[i] += sum;
+    samples_[i] += count;
   }
   // Makes (x, y) hold exactly `value`, as one sample (an image read back, a test's pattern).
   void set(int x, int y, Vec3 value) {
@@ -46,8 +53,9 @@ class Framebuffer {
   const uint32_t* sample_counts() const { return samples_.data(); }
 
  private:
-  size_t index(int x, int y) const { return size_t(y) * size_t(width_) + size_t(x); }
+  size_t index(int x, int y) const { return size_t(y - y0_) * size_t(width_) + size_t(x - x0_); }
   int width_, height_;
+  int x0_ = 0, y0_ = 0;
   std::vector<Vec3> sum_;
   std::vector<uint32_t> samples_;
 };

@@ -106,21 +106,24 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   return radiance;
 }
 
-// Adds this pass's samples to every pixel of `tile`, in sample order. A sample that comes out
-// non-finite (a float overflow on a degenerate path) adds black rather than poisoning the pixel.
+// Adds this pass's samples to every pixel of `tile`: their sum, taken in sample order from zero
+// (see Framebuffer). A sample that comes out non-finite (a float overflow on a degenerate path)
+// adds black rather than poisoning the pixel.
 template <class Accel>
 void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, RayCounts& counts) {
   const RenderSettings& s = ctx.settings;
   for (int y = tile.y0; y < tile.y1; ++y) {
     for (int x = tile.x0; x < tile.x1; ++x) {
       const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
+      Vec3 sum{0.0f};
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const SampleRng rng(pixel, k, s.seed);
         const Ray ray = ctx.camera.ray_through(float(x) + rng.draw(0), float(y) + rng.draw(1));
         ++counts.primary;
         const Vec3 l = path_radiance(accel, ctx, ray, rng, counts);
-        ctx.framebuffer->add(x, y, is_finite(l) ? l : Vec3{0.0f});
+        if (is_finite(l)) sum += l;
       }
+      ctx.framebuffer->add(x, y, sum, ctx.samples.count);
     }
   }
 }
