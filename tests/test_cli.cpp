@@ -97,6 +97,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --integrator path --env 1,1", 2, "--env: expected three finite numbers"},
       {"render --integrator path --light-sampling nee", 2, "--light-sampling: unknown light sampling 'nee'"},
       {"render --integrator path --checkpoint 0", 2, "--checkpoint: must be above 0"},
+      {"render --frames 0", 2, "--frames: must be between 1 and 1000000, got 0"},
       {"render RANGE --stats-json RANGE", 2, "range.obj' is the input scene"},
       {"bench --variants ''", 2, "--variants: empty name in ''"},
       {"bench --scenes ,", 2, "--scenes: empty name in ','"},
@@ -264,6 +265,24 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
     EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
     EXPECT_EQ(count_lines(r.output), 1) << r.output;
   }
+}
+
+TEST_F(Cli, FramesOrbitTheCameraAndNumberTheFiles) {
+  const std::string flags = " -q --integrator ao --width 24 --height 18";
+  auto r = test::run_tracer("render" + flags + " --frames 3 --orbit 90 -o " + dir_ + "/f.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_tracer("render" + flags + " -o " + dir_ + "/single.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* name : {"/f-0000.png", "/f-0001.png", "/f-0002.png"}) EXPECT_TRUE(fs::exists(dir_ + name)) << name;
+  EXPECT_FALSE(fs::exists(dir_ + "/f.png"));
+  // Frame 0 is the camera itself; the others have turned 30 and 60 degrees about the look point.
+  EXPECT_EQ(read_image(dir_ + "/f-0000.png").rgb, read_image(dir_ + "/single.png").rgb);
+  EXPECT_NE(read_image(dir_ + "/f-0001.png").rgb, read_image(dir_ + "/single.png").rgb);
+  EXPECT_NE(read_image(dir_ + "/f-0002.png").rgb, read_image(dir_ + "/f-0001.png").rgb);
+  // Turning 30 degrees is what frame 1 of 3 over 90 degrees is.
+  r = test::run_tracer("render" + flags + " --frames 2 --orbit 60 -o " + dir_ + "/g.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/g-0001.png").rgb, read_image(dir_ + "/f-0001.png").rgb);
 }
 
 TEST_F(Cli, BenchJsonParsesBack) {

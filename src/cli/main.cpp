@@ -14,6 +14,7 @@
 #include "cli/bench.hpp"
 #include "cli/progress.hpp"
 #include "cli/render_args.hpp"
+#include "cli/render_stats.hpp"
 #include "cli/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
@@ -23,74 +24,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// The run's statistics, for --stats (text) and --stats-json.
-nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
-                            const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
-                            const RayCounts& rays) {
-  const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
-  return {{"scene", scene.source},
-          {"triangles", scene.size()},
-          {"width", settings.width},
-          {"height", settings.height},
-          {"ao_samples", settings.ao_samples},
-          {"accel", accel.name},
-          {"packets", settings.packets},
-          {"sched", name_of<SchedKind>(kSchedKindNames, sched.kind)},
-          {"threads", thread_count(sched)},
-          {"load_ms", load_ms},
-          {"build_ms", accel.build_ms},
-          {"render_ms", render_ms},
-          {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
-          {"max_depth", settings.max_depth},
-          {"spp", settings.spp},
-          {"samples_per_s",
-           render_ms > 0 ? double(settings.width) * settings.height * settings.spp / (render_ms * 1e-3) : 0.0},
-          {"rays",
-           {{"primary", rays.primary},
-            {"shadow", rays.shadow},
-            {"ao", rays.ao},
-            {"secondary", rays.secondary},
-            {"total", rays.total()}}},
-          {"mrays_per_s", mrays},
-          {"accel_bytes", accel.memory_bytes()},
-          {"output", args.output}};
-}
-
-void print_stats(const nlohmann::json& j, const Accelerator& accel) {
-  const auto str = [&](const char* k) { return j[k].get<std::string>(); };
-  std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
-  const std::string integrator = str("integrator");
-  const std::string depth = std::to_string(j["max_depth"].get<int>());
-  const std::string workload = integrator == "ao" ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
-                               : integrator == "whitted" ? "whitted, at most " + depth + " reflections/refractions"
-                                                         : "path, " + std::to_string(j["spp"].get<int>()) +
-                                                               " samples per pixel, at most " + depth + " bounces";
-  std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
-              str("output").c_str());
-  std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
-              double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              !j["packets"].get<bool>()         ? ""
-              : accel.kind == AccelKind::Bvh8   ? ", primary rays in 4x4 packets, AO rays in bundles"
-              : accel.kind == AccelKind::Embree ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
-                                                : ", AO rays in bundles");
-  if (const std::optional<BvhStats> st = accel.bvh_stats()) {
-    std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n",
-                st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
-  }
-  std::printf("scheduler    %s, %d threads\n", str("sched").c_str(), j["threads"].get<int>());
-  std::printf("load         %10.2f ms\n", j["load_ms"].get<double>());
-  std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
-  std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
-  const auto& r = j["rays"];
-  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted/bounced, %llu total\n",
-              r["primary"].get<unsigned long long>(), r["shadow"].get<unsigned long long>(),
-              r["ao"].get<unsigned long long>(), r["secondary"].get<unsigned long long>(),
-              r["total"].get<unsigned long long>());
-  std::printf("throughput   %10.2f Mrays/s", j["mrays_per_s"].get<double>());
-  if (integrator == "path") std::printf(", %.3f Msamples/s", j["samples_per_s"].get<double>() * 1e-6);
-  std::printf("\n");
 }
 
 int cmd_render(const RenderArgs& args) {
@@ -118,50 +51,55 @@ int cmd_render(const RenderArgs& args) {
   accel_options.bvh.cancel = cancel;
   const Accelerator accel = build_accelerator(scene, accel_options);
 
-  Framebuffer fb(settings.width, settings.height);
-  RenderContext ctx{&scene, Camera(camera, settings.width, settings.height), settings, &fb};
   RenderControl control;
   control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
-  const auto write_image = [&] { write_render(args.output, fb, settings.exposure, exr_pixel_for(args)); };
-  auto last_write = t_render;
   int checkpoints = 0;
-  const auto checkpoint = [&](uint32_t samples) {
-    if (!args.checkpoint || samples >= uint32_t(settings.spp)) return;
-    if (ms_since(last_write) < *args.checkpoint * 1e3) return;
-    write_image();
-    ++checkpoints;
-    last_write = std::chrono::steady_clock::now();
-  };
-  bool finished;
-  {
-    const uint64_t work = uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp);
-    ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
-    finished = render_passes(accel, ctx, sched, control, checkpoint);
-  }
-  const double render_ms = ms_since(t_render);
-  if (!finished) {
-    // A path render stopped after its first pass is a complete image, only noisier.
-    const uint32_t samples = fb.min_samples();
-    if (samples > 0) {
+  const uint64_t work =
+      uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
+  ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
+  // Each frame of --frames N: the camera orbits the look point; one output file per frame.
+  for (int frame = 0; frame < args.frames; ++frame) {
+    const std::string output = frame_output(args.output, frame, args.frames);
+    Framebuffer fb(settings.width, settings.height);
+    const Camera cam(frame_camera(camera, frame, args.frames, args.orbit), settings.width, settings.height);
+    RenderContext ctx{&scene, cam, settings, &fb};
+    const auto write_image = [&] { write_render(output, fb, settings.exposure, exr_pixel_for(args)); };
+    auto last_write = std::chrono::steady_clock::now();
+    const auto checkpoint = [&](uint32_t samples) {
+      if (!args.checkpoint || samples >= uint32_t(settings.spp)) return;
+      if (ms_since(last_write) < *args.checkpoint * 1e3) return;
       write_image();
-      std::cerr << "tracer: " << stop_signal_name() << " after " << samples << " of " << settings.spp
-                << " samples per pixel; image written to " << args.output << "\n";
-    } else if (args.save_partial && control.pixels_done.load() > 0) {
-      write_image();
-      std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << args.output << "\n";
-    } else {
-      std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
-                << "; no image written\n";
+      ++checkpoints;
+      last_write = std::chrono::steady_clock::now();
+    };
+    if (!render_passes(accel, ctx, sched, control, checkpoint)) {
+      progress.stop();
+      // A path render stopped after its first pass is a complete image, only noisier.
+      const uint32_t samples = fb.min_samples();
+      if (samples > 0) {
+        write_image();
+        std::cerr << "tracer: " << stop_signal_name() << " after " << samples << " of " << settings.spp
+                  << " samples per pixel; image written to " << output << "\n";
+      } else if (args.save_partial && control.pixels_done.load() > 0) {
+        write_image();
+        std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << output << "\n";
+      } else {
+        std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
+                  << "; no image written\n";
+      }
+      return exit_code_for_stop();
     }
-    return exit_code_for_stop();
+    write_image();
+    if (stop_signal() != 0) {  // arrived during the write, which is never torn
+      progress.stop();
+      std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << output
+                << "\n";
+      return exit_code_for_stop();
+    }
   }
-  write_image();
-  if (stop_signal() != 0) {  // arrived during the final write, which is never torn
-    std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << args.output
-              << "\n";
-    return exit_code_for_stop();
-  }
+  progress.stop();
+  const double render_ms = ms_since(t_render);
   nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
   stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <numbers>
 
 #include "base/errors.hpp"
 #include "cli/parse.hpp"
@@ -53,6 +55,12 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                  "path: " + names_of<LightSampling>(kLightSamplingNames) +
                      " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
       ->capture_default_str();
+  app.add_option("--frames", a.frames,
+                 "render an image sequence of this many frames: -o NAME.png gives NAME-0000.png ...")
+      ->capture_default_str();
+  app.add_option("--orbit", a.orbit,
+                 "degrees the camera turns about the look point (around --up) over the --frames sequence")
+      ->capture_default_str();
   app.add_option("--checkpoint", a.checkpoint,
                  "path: rewrite the output every this many seconds while samples accumulate");
   app.add_option("--ao", s.ao_samples, "ambient-occlusion rays per hit, 0 = off")->capture_default_str();
@@ -97,6 +105,8 @@ void validate(const RenderArgs& a) {
   check_range("--ao", s.ao_samples, 0, 4096);
   check_range("--max-depth", s.max_depth, 0, 64);
   if (a.spp) check_range("--spp", *a.spp, 1, 1 << 20);
+  check_range("--frames", a.frames, 1, 1'000'000);
+  check_range_real("--orbit", a.orbit, -1e6, 1e6);
   if (a.checkpoint) check_range_real("--checkpoint", *a.checkpoint, 0.0, 1e9, true);
   if (!a.env.empty()) {
     const Vec3 env = parse_vec3("--env", a.env);
@@ -226,6 +236,26 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
   return spec;
+}
+
+CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double orbit_degrees) {
+  if (frames <= 1 || orbit_degrees == 0.0) return spec;
+  const double angle = orbit_degrees * double(frame) / double(frames) * std::numbers::pi / 180.0;
+  const Vec3 k = normalize(spec.up);
+  const Vec3 v = spec.eye - spec.look;
+  // Rodrigues: v cos + (k x v) sin + k (k . v)(1 - cos).
+  const float c = float(std::cos(angle)), s = float(std::sin(angle));
+  CameraSpec out = spec;
+  out.eye = spec.look + v * c + cross(k, v) * s + k * (dot(k, v) * (1.0f - c));
+  return out;
+}
+
+std::string frame_output(const std::string& output, int frame, int frames) {
+  if (frames <= 1) return output;
+  const fs::path p(output);
+  char number[16];
+  std::snprintf(number, sizeof number, "-%04d", frame);
+  return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
 }
 
 RenderSettings settings_for(const RenderArgs& a) {

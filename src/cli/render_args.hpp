@@ -51,6 +51,8 @@ struct RenderArgs {
   std::optional<int> spp;            // path: samples per pixel (default kDefaultPathSpp)
   std::string env;                   // path: uniform environment radiance r,g,b
   std::optional<double> checkpoint;  // path: seconds between rewrites of the output
+  int frames = 1;                    // --frames: an image sequence, the camera orbiting
+  double orbit = 0.0;                // --orbit: degrees the camera turns over the whole sequence
   std::optional<int> threads;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;
@@ -66,6 +68,11 @@ Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr)
 // -o and --stats-json: known formats, writable, and neither of them the input scene or each other.
 void check_outputs(const RenderArgs& args);
 CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
+// Frame `frame` of `frames`: `spec` with its eye turned about the look point, around the up
+// axis, by orbit_degrees * frame / frames (so 360 over N frames loops without a repeated frame).
+CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double orbit_degrees);
+// The output of frame `frame`: `output` itself for a single frame, else NAME-0007.EXT.
+std::string frame_output(const std::string& output, int frame, int frames);
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
 inline constexpr int kDefaultPathSpp = 64;

@@ -1,0 +1,74 @@
+#include "cli/render_stats.hpp"
+
+#include <cstdio>
+
+namespace tracer::cli {
+
+nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
+                            const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
+                            const RayCounts& rays) {
+  const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
+  return {{"scene", scene.source},
+          {"triangles", scene.size()},
+          {"width", settings.width},
+          {"height", settings.height},
+          {"ao_samples", settings.ao_samples},
+          {"accel", accel.name},
+          {"packets", settings.packets},
+          {"sched", name_of<SchedKind>(kSchedKindNames, sched.kind)},
+          {"threads", thread_count(sched)},
+          {"load_ms", load_ms},
+          {"build_ms", accel.build_ms},
+          {"render_ms", render_ms},
+          {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
+          {"max_depth", settings.max_depth},
+          {"spp", settings.spp},
+          {"samples_per_s",
+           render_ms > 0 ? double(settings.width) * settings.height * settings.spp / (render_ms * 1e-3) : 0.0},
+          {"rays",
+           {{"primary", rays.primary},
+            {"shadow", rays.shadow},
+            {"ao", rays.ao},
+            {"secondary", rays.secondary},
+            {"total", rays.total()}}},
+          {"mrays_per_s", mrays},
+          {"accel_bytes", accel.memory_bytes()},
+          {"output", args.output}};
+}
+
+void print_stats(const nlohmann::json& j, const Accelerator& accel) {
+  const auto str = [&](const char* k) { return j[k].get<std::string>(); };
+  std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
+  const std::string integrator = str("integrator");
+  const std::string depth = std::to_string(j["max_depth"].get<int>());
+  const std::string workload = integrator == "ao" ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
+                               : integrator == "whitted" ? "whitted, at most " + depth + " reflections/refractions"
+                                                         : "path, " + std::to_string(j["spp"].get<int>()) +
+                                                               " samples per pixel, at most " + depth + " bounces";
+  std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
+              str("output").c_str());
+  std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
+              double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
+              !j["packets"].get<bool>()         ? ""
+              : accel.kind == AccelKind::Bvh8   ? ", primary rays in 4x4 packets, AO rays in bundles"
+              : accel.kind == AccelKind::Embree ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
+                                                : ", AO rays in bundles");
+  if (const std::optional<BvhStats> st = accel.bvh_stats()) {
+    std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n",
+                st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
+  }
+  std::printf("scheduler    %s, %d threads\n", str("sched").c_str(), j["threads"].get<int>());
+  std::printf("load         %10.2f ms\n", j["load_ms"].get<double>());
+  std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
+  std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
+  const auto& r = j["rays"];
+  std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted/bounced, %llu total\n",
+              r["primary"].get<unsigned long long>(), r["shadow"].get<unsigned long long>(),
+              r["ao"].get<unsigned long long>(), r["secondary"].get<unsigned long long>(),
+              r["total"].get<unsigned long long>());
+  std::printf("throughput   %10.2f Mrays/s", j["mrays_per_s"].get<double>());
+  if (integrator == "path") std::printf(", %.3f Msamples/s", j["samples_per_s"].get<double>() * 1e-6);
+  std::printf("\n");
+}
+
+}  // namespace tracer::cli

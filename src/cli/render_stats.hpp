@@ -1,0 +1,19 @@
+// The statistics of a render, for --stats (text) and --stats-json: one home for tracer's and
+// tracer-mpi's.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "accel/accelerator.hpp"
+#include "cli/render_args.hpp"
+
+namespace tracer::cli {
+
+nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
+                            const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
+                            const RayCounts& rays);
+
+// Prints `j` (from render_stats()) as the --stats text.
+void print_stats(const nlohmann::json& j, const Accelerator& accel);
+
+}  // namespace tracer::cli
