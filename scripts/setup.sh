@@ -11,6 +11,7 @@ PACKAGES=(
   libtinyobjloader-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
   libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

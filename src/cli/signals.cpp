@@ -21,7 +21,28 @@ extern "C" void on_stop_signal(int sig) {
   g_stop.store(true);
 }
 
+const char* g_immediate_message = nullptr;
+
+extern "C" void on_immediate_stop_signal(int sig) {
+  if (g_immediate_message) {
+    size_t n = 0;
+    while (g_immediate_message[n]) ++n;
+    [[maybe_unused]] const ssize_t w = ::write(STDERR_FILENO, g_immediate_message, n);
+  }
+  remove_pending_temp_file();
+  ::_exit(128 + sig);
+}
+
 }  // namespace
+
+void install_immediate_stop_handlers(const char* message) {
+  g_immediate_message = message;
+  struct sigaction sa {};
+  sa.sa_handler = on_immediate_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+}
 
 void install_stop_handlers() {
   struct sigaction sa {};

@@ -9,6 +9,11 @@
 namespace tracer::cli {
 
 void install_stop_handlers();
+// For a process that cannot stop cleanly on its own (a rank of an MPI job, whose peers the
+// runtime is already tearing down): the first SIGINT, SIGTERM or SIGHUP writes `message` (if not
+// null) to stderr, removes the temporary file of a write in progress and exits 128 + the signal
+// at once. `message` must outlive the process.
+void install_immediate_stop_handlers(const char* message);
 const std::atomic<bool>& stop_requested();
 int stop_signal();               // the first signal received, 0 if none
 int exit_code_for_stop();        // 128 + stop_signal()

@@ -23,6 +23,8 @@ class Texture {
   Vec3 bilinear(float u, float v) const;
   // The linear colour of texel (x, y), rows from the top.
   Vec3 texel(int x, int y) const;
+  // The texels as stored: 8-bit sRGB, RGB, rows from the top.
+  const std::vector<uint8_t>& srgb() const { return srgb_; }
 
  private:
   int width_ = 0, height_ = 0;

@@ -1,0 +1,325 @@
+// tracer-mpi: `tracer render` over the ranks of an Open MPI job. Every rank loads the scene and
+// builds its own accelerator; the scenes' checksums must agree; each pass's tiles are handed out
+// on demand by rank 0 (mpi/tile_server.hpp) to every rank's render threads; rank 0 adds the
+// returned tiles into its framebuffer, in the same order of passes as one process would, and
+// writes the image, the checkpoints and the statistics. The image is byte-identical to
+// `tracer render` with the same flags, for any number of ranks, threads and tile sizes.
+// Exit codes as tracer's: 0, 1 bad input (on any rank), 2 bad usage, 128 + signal when stopped.
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "base/errors.hpp"
+#include "cli/progress.hpp"
+#include "cli/render_args.hpp"
+#include "cli/render_stats.hpp"
+#include "cli/signals.hpp"
+#include "io/image_io.hpp"
+#include "mpi/mpi_session.hpp"
+#include "mpi/tile_server.hpp"
+#include "parallel/parallel_pull.hpp"
+#include "render/render_tile.hpp"
+#include "scene/scene_checksum.hpp"
+
+namespace tracer::mpi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// What one rank did, gathered on rank 0 for the statistics.
+struct RankReport {
+  uint64_t rays = 0;
+  double idle_ms = 0, render_ms = 0;
+};
+
+// Everything every rank sets up before the first pass. `error` is empty when this rank is ready.
+struct Setup {
+  std::optional<Scene> scene;
+  std::optional<Accelerator> accel;
+  CameraSpec camera;
+  RenderSettings settings;
+  SchedOptions sched;
+  int exit_code = 0;
+  std::string error;
+  double load_ms = 0;
+};
+
+Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
+  Setup s;
+  try {
+    cli::validate(args);
+    if (session.root()) cli::check_outputs(args);
+    WideBvh::force_simd_target(cli::simd_target_for(args));
+    const auto t0 = Clock::now();
+    s.scene.emplace(cli::load_scene(args.scene, args.quiet || !session.root()));
+    s.load_ms = ms_since(t0);
+    s.camera = cli::camera_for(*s.scene, args);
+    std::string note;
+    s.settings = cli::settings_for(args, *s.scene, note);
+    if (!note.empty() && !args.quiet && session.root()) std::cerr << "tracer-mpi: note: " << note << "\n";
+    s.sched = cli::sched_options_for(args);
+    AccelOptions accel_options = cli::accel_options_for(args);
+    s.accel.emplace(build_accelerator(*s.scene, accel_options));
+  } catch (const UsageError& e) {
+    s.exit_code = 2;
+    s.error = e.what();
+  } catch (const std::bad_alloc&) {
+    s.exit_code = 1;
+    s.error = "out of memory";
+  } catch (const std::exception& e) {
+    s.exit_code = 1;
+    s.error = e.what();
+  }
+  return s;
+}
+
+// Renders one tile of the current pass into `fb` (rank 0's image, or a window for the tile).
+RayCounts render_one(const Accelerator& accel, const RenderContext& ctx, Framebuffer& fb, const Tile& tile) {
+  RenderContext c = ctx;
+  c.framebuffer = &fb;
+  return accel.visit([&](const auto& a) { return render_tile(a, c, tile); });
+}
+
+// mpirun answers Ctrl-C, and the death of any rank, by sending SIGTERM to every rank: a rank
+// cannot tell which happened, and its peers may already be gone, so each stops at once. Rank 0
+// says so in one line; no image is written (a --checkpoint written before stays: it is complete).
+constexpr const char* kStopMessage =
+    "tracer-mpi: rank 0 stopped by a signal (mpirun sends it on Ctrl-C and when another rank fails: see its "
+    "message); no image written\n";
+
+int run(const cli::RenderArgs& args, MpiSession& session) {
+  cli::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
+  Setup setup = set_up(args, session);
+
+  // Every rank's readiness and scene checksum, judged on rank 0, which says what is wrong once.
+  const std::vector<std::string> errors =
+      session.gather_strings(setup.error.empty() ? "" : std::to_string(setup.exit_code) + " " + setup.error);
+  const std::vector<uint64_t> checksums = session.all_gather(setup.error.empty() ? scene_checksum(*setup.scene) : 0);
+  const int threads = setup.error.empty() ? thread_count(setup.sched) : 0;
+  const std::vector<uint64_t> all_threads = session.all_gather(uint64_t(threads));
+  int verdict = 0;
+  if (session.root()) {
+    for (int r = 0; r < session.size() && verdict == 0; ++r) {
+      const std::string& e = errors[size_t(r)];
+      if (e.empty()) continue;
+      const size_t space = e.find(' ');
+      verdict = std::stoi(e.substr(0, space));
+      const std::string what = e.substr(space + 1);
+      if (verdict == 2) {
+        std::cerr << "tracer-mpi: error: " << what << "\n";  // the same on every rank
+      } else {
+        std::cerr << "tracer-mpi: error: rank " << r << " of " << session.size() << ": " << what << "\n";
+      }
+    }
+    for (int r = 1; r < session.size() && verdict == 0; ++r) {
+      if (checksums[size_t(r)] != checksums[0]) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%016llx, rank 0's %016llx", (unsigned long long)checksums[size_t(r)],
+                      (unsigned long long)checksums[0]);
+        std::cerr << "tracer-mpi: error: rank " << r << " loaded different scene contents than rank 0 (checksum "
+                  << text << "): every rank must read the same scene files\n";
+        verdict = 1;
+      }
+    }
+  }
+  verdict = session.broadcast(verdict);
+  if (verdict != 0) return verdict;
+
+  const Scene& scene = *setup.scene;
+  const Accelerator& accel = *setup.accel;
+  const RenderSettings& settings = setup.settings;
+  const std::vector<Tile> tiles = tiles_for(settings.width, settings.height, setup.sched);
+  int remote_threads = 0;
+  for (int r = 1; r < session.size(); ++r) remote_threads += int(all_threads[size_t(r)]);
+
+  RankReport mine;
+  double server_ms = 0;  // rank 0: time spent answering requests and adding returned tiles
+  uint64_t served = 0;   // rank 0: requests answered
+  AtomicRayCounts counts;
+  std::atomic<uint64_t> pixels_done{0}, rays_done{0};
+  std::vector<uint64_t> tiles_per_rank(size_t(session.size()), 0);
+  int checkpoints = 0;
+  const auto t_render = Clock::now();
+  std::optional<cli::ProgressBar> progress;
+  if (session.root()) {
+    const uint64_t work =
+        uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
+    progress.emplace(!args.quiet, work, pixels_done, rays_done);
+  }
+  std::mutex report_mutex;
+  for (int frame = 0; frame < args.frames; ++frame) {
+    const std::string output = cli::frame_output(args.output, frame, args.frames);
+    std::optional<Framebuffer> fb;
+    if (session.root()) fb.emplace(settings.width, settings.height);
+    const Camera camera(cli::frame_camera(setup.camera, frame, args.frames, args.orbit), settings.width,
+                        settings.height);
+    RenderContext ctx{&scene, camera, settings, nullptr};
+    auto last_write = Clock::now();
+    for (const SampleRange& pass : sample_passes(settings)) {
+      ctx.samples = pass;
+      const auto count = [&](const RayCounts& c, const Tile& t) {
+        counts.add(c);
+        rays_done.fetch_add(c.total(), std::memory_order_relaxed);
+        pixels_done.fetch_add(uint64_t(t.pixel_count()) * pass.count, std::memory_order_relaxed);
+      };
+      if (session.root()) {
+        TileServer server(tiles, remote_threads, session.size());
+        std::exception_ptr own_failure;
+        std::thread own([&] {
+          try {
+            parallel_pull(
+                threads, [&] { return server.take(); },
+                [&](uint32_t i) { count(render_one(accel, ctx, *fb, tiles[i]), tiles[i]); });
+          } catch (...) {
+            own_failure = std::current_exception();
+          }
+        });
+        try {
+          server.serve(*fb, pass.count);
+        } catch (const RankFailed& e) {
+          if (progress) progress->stop();
+          std::cerr << "tracer-mpi: error: rank " << e.rank << " of " << session.size() << ": " << e.what()
+                    << "; no image written\n";
+          MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        own.join();
+        if (own_failure) std::rethrow_exception(own_failure);  // main() reports it and aborts the job
+        server_ms += server.busy_ms();
+        served += server.requests();
+        const std::vector<uint64_t> given = server.tiles_per_rank();
+        for (size_t r = 0; r < given.size(); ++r) tiles_per_rank[r] += given[r];
+        const uint32_t samples = pass.first + pass.count;
+        if (args.checkpoint && samples < uint32_t(settings.spp) && ms_since(last_write) >= *args.checkpoint * 1e3) {
+          write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
+          ++checkpoints;
+          last_write = Clock::now();
+        }
+      } else {
+        TileClient client(tiles);
+        try {
+          // Each thread asks for a tile, renders it into a window of its own and carries the
+          // result into its next request.
+          parallel_run(threads, [&] {
+            std::optional<uint32_t> finished;
+            std::unique_ptr<Framebuffer> result;
+            double idle = 0;
+            while (const std::optional<uint32_t> next = client.request(finished, result.get(), idle)) {
+              const Tile& t = tiles[*next];
+              result = std::make_unique<Framebuffer>(t);
+              count(render_one(accel, ctx, *result, t), t);
+              finished = *next;
+            }
+            std::lock_guard lock(report_mutex);
+            mine.idle_ms += idle;
+          });
+        } catch (const std::exception& e) {
+          TileClient::report_failure(e.what());
+          for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));  // rank 0 aborts the job
+        }
+      }
+    }
+    if (session.root()) {
+      write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
+    }
+  }
+  if (progress) progress->stop();
+  mine.render_ms = ms_since(t_render);
+  mine.rays = counts.load().total();
+
+  // Statistics: every rank's tiles, rays and idle time, on rank 0.
+  const RayCounts own_counts = counts.load();
+  RayCounts total;
+  for (const auto& [field, value] : {std::pair{&RayCounts::primary, own_counts.primary},
+                                     {&RayCounts::shadow, own_counts.shadow},
+                                     {&RayCounts::ao, own_counts.ao},
+                                     {&RayCounts::secondary, own_counts.secondary}}) {
+    for (uint64_t v : session.all_gather(value)) total.*field += v;
+  }
+  const std::vector<uint64_t> rays = session.all_gather(mine.rays);
+  const std::vector<uint64_t> idle_us = session.all_gather(uint64_t(mine.idle_ms * 1e3));
+  const std::vector<uint64_t> render_us = session.all_gather(uint64_t(mine.render_ms * 1e3));
+  if (session.root()) {
+    nlohmann::json stats =
+        cli::render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, mine.render_ms, total);
+    uint64_t all_rays = 0;
+    nlohmann::json ranks = nlohmann::json::array();
+    for (int r = 0; r < session.size(); ++r) {
+      all_rays += rays[size_t(r)];
+      ranks.push_back({{"rank", r},
+                       {"threads", all_threads[size_t(r)]},
+                       {"tiles", tiles_per_rank[size_t(r)]},
+                       {"rays", rays[size_t(r)]},
+                       {"idle_ms", double(idle_us[size_t(r)]) * 1e-3},
+                       {"render_ms", double(render_us[size_t(r)]) * 1e-3}});
+    }
+    stats["ranks"] = ranks;
+    stats["tiles_per_pass"] = tiles.size();
+    stats["passes"] = sample_passes(settings).size() * size_t(args.frames);
+    stats["rays"]["total"] = all_rays;
+    stats["mrays_per_s"] = mine.render_ms > 0 ? double(all_rays) / (mine.render_ms * 1e3) : 0.0;
+    stats["checkpoints_written"] = checkpoints;
+    stats["rank0_message_ms"] = server_ms;
+    stats["rank0_requests"] = served;
+    stats["rank0_us_per_request"] = served > 0 ? server_ms * 1e3 / double(served) : 0.0;
+    if (args.stats) {
+      cli::print_stats(stats, accel);
+      for (const auto& r : ranks) {
+        std::printf("rank %-6d %d threads, %llu tiles, %llu rays, idle %.1f ms\n", r["rank"].get<int>(),
+                    r["threads"].get<int>(), (unsigned long long)r["tiles"].get<uint64_t>(),
+                    (unsigned long long)r["rays"].get<uint64_t>(), r["idle_ms"].get<double>());
+      }
+    }
+    if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace tracer::mpi
+
+int main(int argc, char** argv) {
+  using namespace tracer;
+  std::optional<mpi::MpiSession> session;
+  try {
+    session.emplace(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "tracer-mpi: error: " << e.what() << "\n";
+    return 1;
+  }
+  CLI::App app{"tracer-mpi: tracer render over the ranks of an Open MPI job (mpirun -np N tracer-mpi render ...)"};
+  app.require_subcommand(1);
+  cli::RenderArgs args;
+  CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image, on every rank");
+  cli::add_render_options(*render, args);
+  render->add_option("-o,--output", args.output, "output image (written by rank 0)")->capture_default_str();
+  render->add_flag("--stats", args.stats, "print timings, ray counts and each rank's tiles, rays and idle time");
+  render->add_option("--stats-json", args.stats_json, "write the statistics as JSON to this file (rank 0)");
+  render->add_flag("-q,--quiet", args.quiet, "no progress bar, no loader warnings");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return session->root() ? app.exit(e) : 0;
+    if (session->root()) std::cerr << "tracer-mpi: error: " << e.what() << " (see tracer-mpi --help)\n";
+    return 2;
+  }
+  try {
+    return mpi::run(args, *session);
+  } catch (const std::exception& e) {
+    std::cerr << "tracer-mpi: error: rank " << session->rank() << ": " << e.what() << "\n";
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+  return 1;
+}

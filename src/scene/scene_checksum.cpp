@@ -1,0 +1,66 @@
+#include "scene/scene_checksum.hpp"
+
+#include <cstring>
+#include <type_traits>
+#include <vector>
+
+namespace tracer {
+
+namespace {
+
+class Fnv1a {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) {
+      h_ ^= p[i];
+      h_ *= 0x100000001b3ull;
+    }
+  }
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    value(uint64_t(v.size()));
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  uint64_t get() const { return h_; }
+
+ private:
+  uint64_t h_ = 0xcbf29ce484222325ull;
+};
+
+}  // namespace
+
+uint64_t scene_checksum(const Scene& scene) {
+  Fnv1a h;
+  h.array(scene.triangles);
+  h.array(scene.tri_material);
+  h.array(scene.corner_normals);
+  h.array(scene.corner_uvs);
+  h.value(uint64_t(scene.materials.size()));
+  for (const Material& m : scene.materials) {
+    for (const Vec3& c : {m.kd, m.ks, m.ke, m.tf}) h.value(c);
+    h.value(m.ns);
+    h.value(m.ni);
+    h.value(m.illum);
+    h.value(m.diffuse_texture);
+  }
+  h.value(uint64_t(scene.textures.size()));
+  for (const Texture& t : scene.textures) {
+    h.value(t.width());
+    h.value(t.height());
+    h.array(t.srgb());
+  }
+  h.value(uint64_t(scene.lights.size()));
+  for (const Light& l : scene.lights) {
+    for (const Vec3& c : {l.position, l.normal, l.power}) h.value(c);
+    h.value(l.area);
+  }
+  return h.get();
+}
+
+}  // namespace tracer

@@ -1,0 +1,271 @@
+// tracer-mpi under Open MPI's mpirun on this one machine (loopback): the same image as one
+// process for any number of ranks, threads and tile sizes; every tile handed out exactly once;
+// a killed rank, a missing scene and different scene contents end the job with an error and no
+// image. CI runs as root, so every launch passes Open MPI's --allow-run-as-root; --oversubscribe
+// lets three ranks share two cores.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "test_util.hpp"
+
+namespace tracer {
+namespace {
+
+namespace fs = std::filesystem;
+
+#ifdef TRACER_MPI_EXE
+constexpr const char* kMpiExe = TRACER_MPI_EXE;
+constexpr const char* kMpirun = TRACER_MPIRUN;
+#else
+constexpr const char* kMpiExe = "";
+constexpr const char* kMpirun = "";
+#endif
+
+std::string mpirun(int ranks) {
+  return std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np " + std::to_string(ranks) + " ";
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+test::CommandResult run(const std::string& command) {
+  const std::string out = test::temp_dir() + "/out.txt";
+  const int status = std::system((command + " > " + out + " 2>&1").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read_file(out)};
+}
+
+// The lines tracer-mpi itself printed (mpirun adds a banner of its own to any failed job).
+int own_lines(const std::string& output) {
+  int n = 0;
+  std::istringstream in(output);
+  for (std::string line; std::getline(in, line);) n += line.rfind("tracer-mpi: ", 0) == 0;
+  return n;
+}
+
+class MpiRender : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string(kMpiExe).empty()) GTEST_SKIP() << "tracer-mpi not built (no MPI)";
+    dir_ = test::temp_dir();
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+  std::string dir_;
+};
+
+TEST_F(MpiRender, SameImageAsOneProcessForAnyRanksThreadsAndTiles) {
+  // Linear float EXR, compared byte for byte: every pixel's float sums, not only 8-bit colours.
+  std::vector<std::string> scenes = {""};
+  if (test::have_shared_scenes()) {
+    scenes.push_back(test::scene_path("cornell-box/CornellBox-Original.obj"));
+    scenes.push_back(test::scene_path("cornell-box/CornellBox-Water.obj"));
+  }
+  for (const std::string& scene : scenes) {
+    for (const std::string integrator : {"--integrator ao --ao 4", "--integrator path --spp 6"}) {
+      const std::string common = scene + " " + integrator + " --width 40 --height 30 -q --exr float";
+      const std::string ref = dir_ + "/ref.exr";
+      const auto r = test::run_tracer("render " + common + " -o " + ref);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      const std::string expected = read_file(ref);
+      for (const auto& [ranks, flags] : {std::pair{1, " --threads 2"},
+                                         {2, " --threads 1 --tile 7"},
+                                         {3, " --threads 2 --tile 16"},
+                                         {3, " --threads 1 --tile 5 --accel bvh"}}) {
+        SCOPED_TRACE(scene + " " + integrator + " ranks " + std::to_string(ranks) + flags);
+        const std::string out = dir_ + "/mpi.exr";
+        const auto m = run(mpirun(ranks) + kMpiExe + " render " + common + flags + " -o " + out);
+        ASSERT_EQ(m.exit_code, 0) << m.output;
+        EXPECT_EQ(read_file(out), expected);
+      }
+    }
+  }
+}
+
+TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
+  const std::string common = " --integrator path --spp 2 --width 24 --height 18 -q --frames 3 --orbit 120 -o ";
+  const auto r = test::run_tracer("render" + common + dir_ + "/one.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto m = run(mpirun(2) + kMpiExe + " render --threads 1" + common + dir_ + "/two.png");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  for (const char* n : {"-0000.png", "-0001.png", "-0002.png"}) {
+    EXPECT_EQ(read_file(dir_ + "/two" + n), read_file(dir_ + "/one" + n)) << n;
+    EXPECT_FALSE(read_file(dir_ + "/two" + n).empty()) << n;
+  }
+}
+
+TEST_F(MpiRender, EveryTileIsHandedOutExactlyOnce) {
+  const std::string json = dir_ + "/stats.json";
+  const auto m =
+      run(mpirun(3) + kMpiExe + " render --integrator path --spp 8 --width 50 --height 20 --tile 8 --threads 2 -q -o " +
+          dir_ + "/x.png --stats-json " + json);
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  // 50x20 in 8-pixel tiles: 7 x 3 = 21 tiles per pass; 8 spp runs in passes of 1, 1, 2, 4.
+  EXPECT_EQ(j["tiles_per_pass"], 21);
+  EXPECT_EQ(j["passes"], 4);
+  uint64_t tiles = 0, rays = 0;
+  for (const auto& r : j["ranks"]) {
+    tiles += r["tiles"].get<uint64_t>();
+    rays += r["rays"].get<uint64_t>();
+  }
+  EXPECT_EQ(tiles, 21u * 4u);
+  EXPECT_EQ(j["ranks"].size(), 3u);
+  EXPECT_EQ(j["rays"]["total"].get<uint64_t>(), rays);
+  EXPECT_EQ(j["rays"]["primary"], 50 * 20 * 8);
+}
+
+TEST_F(MpiRender, AMissingSceneOnOneRankIsOneErrorFromRankZero) {
+  // MPMD launch: rank 0 reads an existing file, rank 1 a missing one, as if absent on its node.
+  std::ofstream(dir_ + "/tri.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+  const std::string out = dir_ + "/x.png";
+  const auto m =
+      run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 " + kMpiExe + " render " + dir_ +
+          "/tri.obj -q -o " + out + " : -np 1 " + kMpiExe + " render " + dir_ + "/gone.obj -q -o " + out);
+  EXPECT_EQ(m.exit_code, 1) << m.output;
+  EXPECT_NE(m.output.find("tracer-mpi: error: rank 1 of 2: "), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("gone.obj: cannot open"), std::string::npos) << m.output;
+  EXPECT_EQ(own_lines(m.output), 1) << m.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(MpiRender, DifferentSceneContentsAreDetectedBeforeRendering) {
+  std::ofstream(dir_ + "/a.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir_ + "/b.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1.5 0\nf 1 2 3\n";
+  const std::string out = dir_ + "/x.png";
+  const auto m = run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 " + kMpiExe + " render " +
+                     dir_ + "/a.obj -q -o " + out + " : -np 1 " + kMpiExe + " render " + dir_ + "/b.obj -q -o " + out);
+  EXPECT_EQ(m.exit_code, 1) << m.output;
+  EXPECT_NE(m.output.find("rank 1 loaded different scene contents than rank 0"), std::string::npos) << m.output;
+  EXPECT_EQ(own_lines(m.output), 1) << m.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(MpiRender, BadUsageIsOneErrorAndExitTwo) {
+  const auto m = run(mpirun(2) + kMpiExe + " render --width 0 -q -o " + dir_ + "/x.png");
+  EXPECT_EQ(m.exit_code, 2) << m.output;
+  EXPECT_NE(m.output.find("tracer-mpi: error: --width: must be between 1 and 16384, got 0"), std::string::npos)
+      << m.output;
+  EXPECT_EQ(own_lines(m.output), 1) << m.output;
+}
+
+// The pids of the tracer-mpi processes whose Open MPI rank is `rank` and whose command line
+// names `dir` (tests run concurrently: only this test's job).
+std::vector<pid_t> pids_of_rank(int rank, const std::string& dir) {
+  std::vector<pid_t> pids;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string cmdline = read_file(entry.path().string() + "/cmdline");
+    if (cmdline.find("tracer-mpi") == std::string::npos || cmdline.find(dir) == std::string::npos ||
+        cmdline.rfind(kMpirun, 0) == 0) {
+      continue;
+    }
+    const std::string env = read_file(entry.path().string() + "/environ");
+    if (env.find(std::string("OMPI_COMM_WORLD_RANK=") + std::to_string(rank) + '\0') != std::string::npos) {
+      pids.push_back(pid_t(std::stoi(name)));
+    }
+  }
+  return pids;
+}
+
+// Starts `command` under /bin/sh in the background; its output goes to `log`.
+pid_t launch(const std::string& command, const std::string& log) {
+  const std::string full = command + " > " + log + " 2>&1";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", full.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits for `pid`; its exit code, or 128 + the signal; and how many seconds that took.
+std::pair<int, double> wait_for(pid_t pid) {
+  const auto t0 = std::chrono::steady_clock::now();
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return {-1, 0.0};
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), seconds};
+}
+
+// A long path render on three ranks, and the pid of the process running rank `rank` once it runs.
+pid_t start_long_job(const std::string& dir, const std::string& log, int rank, pid_t& launcher) {
+  launcher = launch(mpirun(3) + kMpiExe + " render --integrator path --spp 1000000 --width 64 --height 64 -q " +
+                        "--threads 1 -o " + dir + "/x.png",
+                    log);
+  for (int i = 0; i < 200; ++i) {  // up to 20 s for the job to start
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const std::vector<pid_t> pids = pids_of_rank(rank, dir);
+    if (pids.size() == 1) {
+      std::this_thread::sleep_for(std::chrono::seconds(1));  // into the render
+      return pids[0];
+    }
+  }
+  return -1;
+}
+
+TEST_F(MpiRender, AKilledRankEndsTheJobWithinSecondsAndLeavesNoImage) {
+  // Open MPI's runtime sees rank 1 die and stops the job: its message names the rank and the
+  // signal; rank 0 says it was stopped; no image; within a bounded time.
+  const std::string log = dir_ + "/log.txt";
+  pid_t launcher = -1;
+  const pid_t victim = start_long_job(dir_, log, 1, launcher);
+  ASSERT_GT(victim, 0) << read_file(log);
+  ::kill(victim, SIGKILL);
+  const auto [code, seconds] = wait_for(launcher);
+  EXPECT_LT(seconds, 15.0) << "the job did not end promptly after rank 1 was killed";
+  EXPECT_NE(code, 0);
+  const std::string text = read_file(log);
+  EXPECT_NE(text.find("process rank 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("signal 9"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png")) << text;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+  }
+}
+
+TEST_F(MpiRender, CtrlCOnMpirunStopsEveryRank) {
+  // mpirun turns Ctrl-C into SIGTERM for every rank and exits 1 itself (Open MPI's choice).
+  const std::string log = dir_ + "/log.txt";
+  pid_t launcher = -1;
+  const pid_t rank0 = start_long_job(dir_, log, 0, launcher);
+  ASSERT_GT(rank0, 0) << read_file(log);
+  // mpirun is the launcher shell's child: signal it as a terminal's Ctrl-C would.
+  bool sent = false;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string cmdline = read_file(entry.path().string() + "/cmdline");
+    if (cmdline.rfind(kMpirun, 0) == 0 && cmdline.find(dir_) != std::string::npos) {
+      ::kill(pid_t(std::stoi(entry.path().filename().string())), SIGINT);
+      sent = true;
+    }
+  }
+  ASSERT_TRUE(sent);
+  const auto [code, seconds] = wait_for(launcher);
+  EXPECT_LT(seconds, 15.0);
+  EXPECT_NE(code, 0);
+  const std::string text = read_file(log);
+  EXPECT_NE(text.find("tracer-mpi: rank 0 stopped by a signal"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+  EXPECT_TRUE(pids_of_rank(0, dir_).empty() && pids_of_rank(1, dir_).empty() && pids_of_rank(2, dir_).empty());
+}
+
+}  // namespace
+}  // namespace tracer
