@@ -71,6 +71,19 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
     s.settings = cli::settings_for(args, *s.scene, note);
     if (!note.empty() && !args.quiet && session.root()) std::cerr << "tracer-mpi: note: " << note << "\n";
     s.sched = cli::sched_options_for(args);
+    const int usable = resolve_thread_count(0);
+    const int machine = int(std::thread::hardware_concurrency());
+    if (args.threads && *args.threads > usable && usable < machine) {
+      // Open MPI binds each rank to a core when there are two ranks or fewer: a hybrid run then
+      // time-shares that core. Each affected rank says so (nodes may differ).
+      const std::string line = "tracer-mpi: warning: rank " + std::to_string(session.rank()) + " may use " +
+                               std::to_string(usable) + " of this node's " + std::to_string(machine) +
+                               " CPUs for its " + std::to_string(*args.threads) +
+                               " threads (mpirun binds ranks to cores: add --bind-to none, or --map-by "
+                               "ppr:1:node:PE=" +
+                               std::to_string(*args.threads) + ")\n";
+      std::fputs(line.c_str(), stderr);  // one write: the ranks' lines do not interleave
+    }
     AccelOptions accel_options = cli::accel_options_for(args);
     s.accel.emplace(build_accelerator(*s.scene, accel_options));
   } catch (const UsageError& e) {
@@ -102,6 +115,7 @@ constexpr const char* kStopMessage =
 
 int run(const cli::RenderArgs& args, MpiSession& session) {
   cli::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
+  const ThreadLimit thread_limit(args.threads.value_or(0));
   Setup setup = set_up(args, session);
 
   // Every rank's readiness and scene checksum, judged on rank 0, which says what is wrong once.
@@ -146,8 +160,8 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
   for (int r = 1; r < session.size(); ++r) remote_threads += int(all_threads[size_t(r)]);
 
   RankReport mine;
-  double server_ms = 0;  // rank 0: time spent answering requests and adding returned tiles
-  uint64_t served = 0;   // rank 0: requests answered
+  double server_ms = 0;  // rank 0: time spent on messages (requests, returned tiles, done)
+  uint64_t served = 0;   // rank 0: messages handled
   AtomicRayCounts counts;
   std::atomic<uint64_t> pixels_done{0}, rays_done{0};
   std::vector<uint64_t> tiles_per_rank(size_t(session.size()), 0);
@@ -160,6 +174,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     progress.emplace(!args.quiet, work, pixels_done, rays_done);
   }
   std::mutex report_mutex;
+  uint32_t pass_serial = 0;  // passes over all frames, for their messages' tags
   for (int frame = 0; frame < args.frames; ++frame) {
     const std::string output = cli::frame_output(args.output, frame, args.frames);
     std::optional<Framebuffer> fb;
@@ -170,13 +185,14 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     auto last_write = Clock::now();
     for (const SampleRange& pass : sample_passes(settings)) {
       ctx.samples = pass;
+      ++pass_serial;
       const auto count = [&](const RayCounts& c, const Tile& t) {
         counts.add(c);
         rays_done.fetch_add(c.total(), std::memory_order_relaxed);
         pixels_done.fetch_add(uint64_t(t.pixel_count()) * pass.count, std::memory_order_relaxed);
       };
       if (session.root()) {
-        TileServer server(tiles, remote_threads, session.size());
+        TileServer server(tiles, remote_threads, session.size(), pass_serial);
         std::exception_ptr own_failure;
         std::thread own([&] {
           try {
@@ -198,7 +214,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
         own.join();
         if (own_failure) std::rethrow_exception(own_failure);  // main() reports it and aborts the job
         server_ms += server.busy_ms();
-        served += server.requests();
+        served += server.messages();
         const std::vector<uint64_t> given = server.tiles_per_rank();
         for (size_t r = 0; r < given.size(); ++r) tiles_per_rank[r] += given[r];
         const uint32_t samples = pass.first + pass.count;
@@ -208,15 +224,17 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
           last_write = Clock::now();
         }
       } else {
-        TileClient client(tiles);
+        TileClient client(tiles, pass_serial);
         try {
-          // Each thread asks for a tile, renders it into a window of its own and carries the
-          // result into its next request.
+          // Each thread renders its tiles into windows of its own and sends them back; its next
+          // request is already in flight while it renders.
+          std::atomic<int> thread_ids{0};
           parallel_run(threads, [&] {
+            TileClient::Worker worker(client, thread_ids.fetch_add(1));
             std::optional<uint32_t> finished;
             std::unique_ptr<Framebuffer> result;
             double idle = 0;
-            while (const std::optional<uint32_t> next = client.request(finished, result.get(), idle)) {
+            while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
               const Tile& t = tiles[*next];
               result = std::make_unique<Framebuffer>(t);
               count(render_one(accel, ctx, *result, t), t);
@@ -272,10 +290,12 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     stats["mrays_per_s"] = mine.render_ms > 0 ? double(all_rays) / (mine.render_ms * 1e3) : 0.0;
     stats["checkpoints_written"] = checkpoints;
     stats["rank0_message_ms"] = server_ms;
-    stats["rank0_requests"] = served;
-    stats["rank0_us_per_request"] = served > 0 ? server_ms * 1e3 / double(served) : 0.0;
+    stats["rank0_messages"] = served;
+    stats["rank0_us_per_message"] = served > 0 ? server_ms * 1e3 / double(served) : 0.0;
     if (args.stats) {
       cli::print_stats(stats, accel);
+      std::printf("rank 0       %.1f ms on %llu messages (%.1f us each)\n", server_ms, (unsigned long long)served,
+                  served > 0 ? server_ms * 1e3 / double(served) : 0.0);
       for (const auto& r : ranks) {
         std::printf("rank %-6d %d threads, %llu tiles, %llu rays, idle %.1f ms\n", r["rank"].get<int>(),
                     r["threads"].get<int>(), (unsigned long long)r["tiles"].get<uint64_t>(),

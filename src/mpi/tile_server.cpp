@@ -1,7 +1,5 @@
 #include "mpi/tile_server.hpp"
 
-#include <mpi.h>
-
 #include <chrono>
 #include <cstring>
 #include <thread>
@@ -10,19 +8,27 @@ namespace tracer::mpi {
 
 namespace {
 
-constexpr int kTagRequest = 101;  // a thread's request for a tile, with the tile it finished
-constexpr int kTagAssign = 102;   // rank 0's answer: a tile index, or -1 when the pass is over
-constexpr int kTagFailure = 103;  // a rank's error message
+// Kinds of message within a pass (see pass_tag()).
+constexpr int kRequest = 0;  // int32 {thread}: send me a tile
+constexpr int kResult = 1;   // int32 tile, then its pixels' sums (three floats each, row by row)
+constexpr int kDone = 2;     // int32 {thread}: this thread has sent everything, the pass is over for it
+constexpr int kKinds = 3;
+constexpr uint32_t kPassSlots = 4096;  // tags repeat after this many passes; far apart by then
+constexpr int kTagFailure = 1;         // a rank's error message, whenever it happens
+constexpr int kTagAnswer = 16;         // + thread: rank 0's answer, a tile index or -1 when none is left
+constexpr int kTagPassBase = 2048;     // above every answer tag (threads are at most 1024); the
+                                       // largest tag, 2048 + 3 * 4096, is within the 32767 MPI promises
 
-// A request: the finished tile (or -1), then its pixels' sums (three floats each, row by row).
-struct RequestHeader {
-  int32_t finished;
-};
+// Polling rather than blocking: Open MPI spins in blocking calls, which would take a core from
+// the render threads. Far below a tile's time.
+void pause() { std::this_thread::sleep_for(std::chrono::microseconds(20)); }
 
 }  // namespace
 
-TileServer::TileServer(const std::vector<Tile>& tiles, int remote_threads, int ranks)
-    : tiles_(tiles), remote_threads_(remote_threads), tiles_per_rank_(size_t(ranks), 0) {}
+int pass_tag(uint32_t serial, int kind) { return kTagPassBase + int(serial % kPassSlots) * kKinds + kind; }
+
+TileServer::TileServer(const std::vector<Tile>& tiles, int remote_threads, int ranks, uint32_t pass_serial)
+    : tiles_(tiles), remote_threads_(remote_threads), serial_(pass_serial), tiles_per_rank_(size_t(ranks), 0) {}
 
 std::optional<uint32_t> TileServer::take() {
   const uint32_t t = next_.fetch_add(1, std::memory_order_relaxed);
@@ -33,15 +39,18 @@ std::optional<uint32_t> TileServer::take() {
 
 void TileServer::serve(Framebuffer& fb, uint32_t samples) {
   std::vector<char> buffer;
-  int finished_threads = 0;
-  while (finished_threads < remote_threads_) {
+  int done_threads = 0;
+  while (done_threads < remote_threads_) {
+    // This pass's messages, and failures; a later pass's requests wait in the queue.
     int flag = 0;
     MPI_Status status;
-    MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status);
+    for (const int tag :
+         {kTagFailure, pass_tag(serial_, kResult), pass_tag(serial_, kDone), pass_tag(serial_, kRequest)}) {
+      MPI_Iprobe(MPI_ANY_SOURCE, tag, MPI_COMM_WORLD, &flag, &status);
+      if (flag) break;
+    }
     if (!flag) {
-      // Polling rather than a blocking receive: Open MPI spins in blocking calls, which would
-      // take a core from rank 0's own render threads. 50 us is far below a tile's time.
-      std::this_thread::sleep_for(std::chrono::microseconds(50));
+      pause();
       continue;
     }
     const auto t0 = std::chrono::steady_clock::now();
@@ -49,15 +58,24 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
     MPI_Get_count(&status, MPI_BYTE, &bytes);
     buffer.resize(size_t(bytes));
     MPI_Recv(buffer.data(), bytes, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    if (status.MPI_TAG == kTagFailure) throw RankFailed(status.MPI_SOURCE, std::string(buffer.begin(), buffer.end()));
-    if (status.MPI_TAG != kTagRequest || size_t(bytes) < sizeof(RequestHeader)) continue;
-    RequestHeader header;
-    std::memcpy(&header, buffer.data(), sizeof header);
-    if (header.finished >= 0 && size_t(header.finished) < tiles_.size()) {
-      const Tile& t = tiles_[size_t(header.finished)];
-      const size_t floats = size_t(t.pixel_count()) * 3;
-      if (size_t(bytes) == sizeof header + floats * sizeof(float)) {
-        const char* p = buffer.data() + sizeof header;
+    int32_t first = -1;
+    if (size_t(bytes) >= sizeof first) std::memcpy(&first, buffer.data(), sizeof first);
+    const int kind = status.MPI_TAG == kTagFailure ? -1 : (status.MPI_TAG - kTagPassBase) % kKinds;
+    switch (kind) {
+      case -1:
+        throw RankFailed(status.MPI_SOURCE, std::string(buffer.begin(), buffer.end()));
+      case kRequest: {
+        const uint32_t next = next_.fetch_add(1, std::memory_order_relaxed);
+        const int32_t answer = next < tiles_.size() ? int32_t(next) : -1;
+        if (answer >= 0) ++tiles_per_rank_[size_t(status.MPI_SOURCE)];
+        MPI_Send(&answer, 1, MPI_INT32_T, status.MPI_SOURCE, kTagAnswer + first, MPI_COMM_WORLD);
+        break;
+      }
+      case kResult: {
+        if (first < 0 || size_t(first) >= tiles_.size()) break;
+        const Tile& t = tiles_[size_t(first)];
+        if (size_t(bytes) != sizeof first + size_t(t.pixel_count()) * 3 * sizeof(float)) break;
+        const char* p = buffer.data() + sizeof first;
         for (int y = t.y0; y < t.y1; ++y) {
           for (int x = t.x0; x < t.x1; ++x) {
             float c[3];
@@ -66,43 +84,103 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
             fb.add(x, y, Vec3{c[0], c[1], c[2]}, samples);
           }
         }
+        break;
       }
+      case kDone:
+        ++done_threads;
+        break;
+      default:
+        break;
     }
-    const uint32_t next = next_.fetch_add(1, std::memory_order_relaxed);
-    const int32_t answer = next < tiles_.size() ? int32_t(next) : -1;
-    if (answer < 0) {
-      ++finished_threads;
-    } else {
-      ++tiles_per_rank_[size_t(status.MPI_SOURCE)];
-    }
-    MPI_Send(&answer, 1, MPI_INT32_T, status.MPI_SOURCE, kTagAssign, MPI_COMM_WORLD);
     busy_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    ++requests_;
+    ++messages_;
   }
 }
 
-std::optional<uint32_t> TileClient::request(std::optional<uint32_t> finished, const Framebuffer* sums,
-                                            double& idle_ms) {
+TileClient::Worker::Worker(TileClient& client, int thread) : client_(client), thread_(thread) {}
+
+TileClient::Worker::~Worker() {
+  // Normally nothing is outstanding here; after an error, give up what is.
+  std::lock_guard lock(client_.mutex_);
+  for (MPI_Request* r : {&request_send_, &answer_recv_, &result_send_}) {
+    if (*r == MPI_REQUEST_NULL) continue;
+    int flag = 0;
+    MPI_Test(r, &flag, MPI_STATUS_IGNORE);
+    if (!flag) {
+      MPI_Cancel(r);
+      MPI_Request_free(r);
+    }
+  }
+}
+
+void TileClient::Worker::post_request() {
+  std::lock_guard lock(client_.mutex_);
+  if (request_send_ != MPI_REQUEST_NULL) MPI_Wait(&request_send_, MPI_STATUS_IGNORE);  // 8 bytes: long sent
+  request_[0] = thread_;
+  MPI_Irecv(&answer_, 1, MPI_INT32_T, 0, kTagAnswer + thread_, MPI_COMM_WORLD, &answer_recv_);
+  MPI_Isend(request_, 2, MPI_INT32_T, 0, pass_tag(client_.serial_, kRequest), MPI_COMM_WORLD, &request_send_);
+}
+
+int32_t TileClient::Worker::wait_answer(double& idle_ms) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::lock_guard lock(mutex_);
-  const RequestHeader header{finished ? int32_t(*finished) : -1};
-  buffer_.assign(reinterpret_cast<const char*>(&header), reinterpret_cast<const char*>(&header) + sizeof header);
+  for (;;) {
+    int flag = 0;
+    {
+      std::lock_guard lock(client_.mutex_);
+      MPI_Test(&answer_recv_, &flag, MPI_STATUS_IGNORE);
+    }
+    if (flag) break;
+    pause();
+  }
+  idle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return answer_;
+}
+
+void TileClient::Worker::wait_send() {
+  for (;;) {
+    int flag = 0;
+    {
+      std::lock_guard lock(client_.mutex_);
+      MPI_Test(&result_send_, &flag, MPI_STATUS_IGNORE);
+    }
+    if (flag) return;
+    pause();
+  }
+}
+
+std::optional<uint32_t> TileClient::Worker::next(std::optional<uint32_t> finished, const Framebuffer* sums,
+                                                 double& idle_ms) {
+  if (!started_) {
+    post_request();
+    started_ = true;
+  }
   if (finished && sums) {
-    const Tile& t = tiles_[*finished];
+    wait_send();  // the previous result's buffer is free again
+    const Tile& t = client_.tiles_[*finished];
+    const int32_t index = int32_t(*finished);
+    result_.assign(reinterpret_cast<const char*>(&index), reinterpret_cast<const char*>(&index) + sizeof index);
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
         const Vec3& v = sums->sums()[size_t(y - t.y0) * size_t(t.x1 - t.x0) + size_t(x - t.x0)];
         const float c[3] = {v.x, v.y, v.z};
-        buffer_.insert(buffer_.end(), reinterpret_cast<const char*>(c), reinterpret_cast<const char*>(c) + sizeof c);
+        result_.insert(result_.end(), reinterpret_cast<const char*>(c), reinterpret_cast<const char*>(c) + sizeof c);
       }
     }
+    std::lock_guard lock(client_.mutex_);
+    MPI_Isend(result_.data(), int(result_.size()), MPI_BYTE, 0, pass_tag(client_.serial_, kResult), MPI_COMM_WORLD,
+              &result_send_);
   }
-  MPI_Send(buffer_.data(), int(buffer_.size()), MPI_BYTE, 0, kTagRequest, MPI_COMM_WORLD);
-  int32_t answer = -1;
-  MPI_Recv(&answer, 1, MPI_INT32_T, 0, kTagAssign, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  idle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (answer < 0) return std::nullopt;
-  return uint32_t(answer);
+  const int32_t tile = wait_answer(idle_ms);
+  if (tile < 0) {
+    wait_send();
+    std::lock_guard lock(client_.mutex_);
+    if (request_send_ != MPI_REQUEST_NULL) MPI_Wait(&request_send_, MPI_STATUS_IGNORE);
+    const int32_t me = thread_;
+    MPI_Send(&me, 1, MPI_INT32_T, 0, pass_tag(client_.serial_, kDone), MPI_COMM_WORLD);
+    return std::nullopt;
+  }
+  post_request();  // the next tile travels while this one renders
+  return uint32_t(tile);
 }
 
 void TileClient::report_failure(const std::string& message) {
