@@ -261,9 +261,8 @@ TEST_F(MpiRender, CtrlCOnMpirunStopsEveryRank) {
   const auto [code, seconds] = wait_for(launcher);
   EXPECT_LT(seconds, 15.0);
   EXPECT_NE(code, 0);
-  const std::string text = read_file(log);
-  EXPECT_NE(text.find("tracer-mpi: rank 0 stopped by a signal"), std::string::npos) << text;
-  EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+  // (Rank 0 also says it was stopped, but mpirun, shutting down, may drop that line.)
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png")) << read_file(log);
   EXPECT_TRUE(pids_of_rank(0, dir_).empty() && pids_of_rank(1, dir_).empty() && pids_of_rank(2, dir_).empty());
 }
 

@@ -39,6 +39,9 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
+// One line to stderr in one write, so lines from several ranks (and mpirun's own) never interleave.
+void say(const std::string& line) { std::fputs((line + "\n").c_str(), stderr); }
+
 // What one rank did, gathered on rank 0 for the statistics.
 struct RankReport {
   uint64_t rays = 0;
@@ -69,7 +72,7 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
     s.camera = cli::camera_for(*s.scene, args);
     std::string note;
     s.settings = cli::settings_for(args, *s.scene, note);
-    if (!note.empty() && !args.quiet && session.root()) std::cerr << "tracer-mpi: note: " << note << "\n";
+    if (!note.empty() && !args.quiet && session.root()) say("tracer-mpi: note: " + note);
     s.sched = cli::sched_options_for(args);
     const int usable = resolve_thread_count(0);
     const int machine = int(std::thread::hardware_concurrency());
@@ -133,9 +136,9 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
       verdict = std::stoi(e.substr(0, space));
       const std::string what = e.substr(space + 1);
       if (verdict == 2) {
-        std::cerr << "tracer-mpi: error: " << what << "\n";  // the same on every rank
+        say("tracer-mpi: error: " + what);  // the same on every rank
       } else {
-        std::cerr << "tracer-mpi: error: rank " << r << " of " << session.size() << ": " << what << "\n";
+        say("tracer-mpi: error: rank " + std::to_string(r) + " of " + std::to_string(session.size()) + ": " + what);
       }
     }
     for (int r = 1; r < session.size() && verdict == 0; ++r) {
@@ -143,14 +146,19 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
         char text[64];
         std::snprintf(text, sizeof text, "%016llx, rank 0's %016llx", (unsigned long long)checksums[size_t(r)],
                       (unsigned long long)checksums[0]);
-        std::cerr << "tracer-mpi: error: rank " << r << " loaded different scene contents than rank 0 (checksum "
-                  << text << "): every rank must read the same scene files\n";
+        say("tracer-mpi: error: rank " + std::to_string(r) + " loaded different scene contents than rank 0 (checksum " +
+            text + "): every rank must read the same scene files");
         verdict = 1;
       }
     }
   }
   verdict = session.broadcast(verdict);
-  if (verdict != 0) return verdict;
+  if (verdict != 0) {
+    // The first rank to exit non-zero makes mpirun stop the others with SIGTERM: rank 0 has said
+    // what is wrong, so that signal needs no second message.
+    cli::install_immediate_stop_handlers(nullptr);
+    return verdict;
+  }
 
   const Scene& scene = *setup.scene;
   const Accelerator& accel = *setup.accel;
@@ -207,8 +215,8 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
           server.serve(*fb, pass.count);
         } catch (const RankFailed& e) {
           if (progress) progress->stop();
-          std::cerr << "tracer-mpi: error: rank " << e.rank << " of " << session.size() << ": " << e.what()
-                    << "; no image written\n";
+          say("tracer-mpi: error: rank " + std::to_string(e.rank) + " of " + std::to_string(session.size()) + ": " +
+              e.what() + "; no image written");
           MPI_Abort(MPI_COMM_WORLD, 1);
         }
         own.join();
@@ -316,7 +324,7 @@ int main(int argc, char** argv) {
   try {
     session.emplace(argc, argv);
   } catch (const std::exception& e) {
-    std::cerr << "tracer-mpi: error: " << e.what() << "\n";
+    tracer::mpi::say(std::string("tracer-mpi: error: ") + e.what());
     return 1;
   }
   CLI::App app{"tracer-mpi: tracer render over the ranks of an Open MPI job (mpirun -np N tracer-mpi render ...)"};
@@ -332,13 +340,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return session->root() ? app.exit(e) : 0;
-    if (session->root()) std::cerr << "tracer-mpi: error: " << e.what() << " (see tracer-mpi --help)\n";
+    if (session->root()) mpi::say(std::string("tracer-mpi: error: ") + e.what() + " (see tracer-mpi --help)");
     return 2;
   }
   try {
     return mpi::run(args, *session);
   } catch (const std::exception& e) {
-    std::cerr << "tracer-mpi: error: rank " << session->rank() << ": " << e.what() << "\n";
+    mpi::say("tracer-mpi: error: rank " + std::to_string(session->rank()) + ": " + e.what());
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
   return 1;
