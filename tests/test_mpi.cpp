@@ -87,8 +87,13 @@ TEST_F(MpiRender, SameImageAsOneProcessForAnyRanksThreadsAndTiles) {
       for (const auto& [ranks, flags] : {std::pair{1, " --threads 2"},
                                          {2, " --threads 1 --tile 7"},
                                          {3, " --threads 2 --tile 16"},
-                                         {3, " --threads 1 --tile 5 --accel bvh"}}) {
+                                         {3, " --threads 1 --tile 5 --accel bvh"},
+                                         {2, " --threads 2 --tile 9 --checkpoint 1000"}}) {
         SCOPED_TRACE(scene + " " + integrator + " ranks " + std::to_string(ranks) + flags);
+        if (std::string(flags).find("--checkpoint") != std::string::npos &&
+            integrator.find("path") == std::string::npos) {
+          continue;  // --checkpoint (one round per pass) is path's
+        }
         const std::string out = dir_ + "/mpi.exr";
         const auto m = run(mpirun(ranks) + kMpiExe + " render " + common + flags + " -o " + out);
         ASSERT_EQ(m.exit_code, 0) << m.output;
@@ -111,25 +116,31 @@ TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
 }
 
 TEST_F(MpiRender, EveryTileIsHandedOutExactlyOnce) {
-  const std::string json = dir_ + "/stats.json";
-  const auto m =
-      run(mpirun(3) + kMpiExe + " render --integrator path --spp 8 --width 50 --height 20 --tile 8 --threads 2 -q -o " +
-          dir_ + "/x.png --stats-json " + json);
-  ASSERT_EQ(m.exit_code, 0) << m.output;
-  std::ifstream in(json);
-  const nlohmann::json j = nlohmann::json::parse(in);
-  // 50x20 in 8-pixel tiles: 7 x 3 = 21 tiles per pass; 8 spp runs in passes of 1, 1, 2, 4.
-  EXPECT_EQ(j["tiles_per_pass"], 21);
-  EXPECT_EQ(j["passes"], 4);
-  uint64_t tiles = 0, rays = 0;
-  for (const auto& r : j["ranks"]) {
-    tiles += r["tiles"].get<uint64_t>();
-    rays += r["rays"].get<uint64_t>();
+  // 50x20 in 8-pixel tiles: 7 x 3 = 21 tiles; 8 spp runs in passes of 1, 1, 2, 4. Without
+  // --checkpoint each tile is rendered whole, in one round; with it, one round per pass.
+  for (const bool progressive : {false, true}) {
+    SCOPED_TRACE(progressive ? "--checkpoint" : "whole tiles");
+    const std::string json = dir_ + "/stats.json";
+    const auto m = run(mpirun(3) + kMpiExe +
+                       " render --integrator path --spp 8 --width 50 --height 20 --tile 8 --threads 2 -q -o " + dir_ +
+                       "/x.png --stats-json " + json + (progressive ? " --checkpoint 1000" : ""));
+    ASSERT_EQ(m.exit_code, 0) << m.output;
+    std::ifstream in(json);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["tiles_per_pass"], 21);
+    EXPECT_EQ(j["passes"], 4);
+    const uint64_t rounds = progressive ? 4 : 1;
+    EXPECT_EQ(j["rounds"], rounds);
+    uint64_t tiles = 0, rays = 0;
+    for (const auto& r : j["ranks"]) {
+      tiles += r["tiles"].get<uint64_t>();
+      rays += r["rays"].get<uint64_t>();
+    }
+    EXPECT_EQ(tiles, 21u * rounds);
+    EXPECT_EQ(j["ranks"].size(), 3u);
+    EXPECT_EQ(j["rays"]["total"].get<uint64_t>(), rays);
+    EXPECT_EQ(j["rays"]["primary"], 50 * 20 * 8);
   }
-  EXPECT_EQ(tiles, 21u * 4u);
-  EXPECT_EQ(j["ranks"].size(), 3u);
-  EXPECT_EQ(j["rays"]["total"].get<uint64_t>(), rays);
-  EXPECT_EQ(j["rays"]["primary"], 50 * 20 * 8);
 }
 
 TEST_F(MpiRender, AMissingSceneOnOneRankIsOneErrorFromRankZero) {

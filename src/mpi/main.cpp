@@ -102,11 +102,30 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
   return s;
 }
 
-// Renders one tile of the current pass into `fb` (rank 0's image, or a window for the tile).
-RayCounts render_one(const Accelerator& accel, const RenderContext& ctx, Framebuffer& fb, const Tile& tile) {
+// The passes each round of tile distribution covers. With --checkpoint, one round per pass, so
+// rank 0 has every pass complete in turn; without, one round of every pass: each tile is
+// rendered whole (its passes in order, adding up exactly as one process adds them) and crosses
+// the network once, so rank 0 adds each pixel once instead of once per pass.
+std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool progressive) {
+  const std::vector<SampleRange> passes = sample_passes(settings);
+  if (!progressive) return {passes};
+  std::vector<std::vector<SampleRange>> rounds;
+  for (const SampleRange& p : passes) rounds.push_back({p});
+  return rounds;
+}
+
+// Renders the passes of `round` of one tile, in order, into `fb` (rank 0's image, or a window for
+// the tile).
+RayCounts render_one(const Accelerator& accel, const RenderContext& ctx, const std::vector<SampleRange>& round,
+                     Framebuffer& fb, const Tile& tile) {
   RenderContext c = ctx;
   c.framebuffer = &fb;
-  return accel.visit([&](const auto& a) { return render_tile(a, c, tile); });
+  RayCounts counts;
+  for (const SampleRange& pass : round) {
+    c.samples = pass;
+    counts += accel.visit([&](const auto& a) { return render_tile(a, c, tile); });
+  }
+  return counts;
 }
 
 // mpirun answers Ctrl-C, and the death of any rank, by sending SIGTERM to every rank: a rank
@@ -182,7 +201,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     progress.emplace(!args.quiet, work, pixels_done, rays_done);
   }
   std::mutex report_mutex;
-  uint32_t pass_serial = 0;  // passes over all frames, for their messages' tags
+  uint32_t round_serial = 0;  // rounds over all frames, for their messages' tags
   for (int frame = 0; frame < args.frames; ++frame) {
     const std::string output = cli::frame_output(args.output, frame, args.frames);
     std::optional<Framebuffer> fb;
@@ -191,28 +210,28 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
                         settings.height);
     RenderContext ctx{&scene, camera, settings, nullptr};
     auto last_write = Clock::now();
-    for (const SampleRange& pass : sample_passes(settings)) {
-      ctx.samples = pass;
-      ++pass_serial;
+    for (const std::vector<SampleRange>& round : rounds_of(settings, args.checkpoint.has_value())) {
+      ++round_serial;
+      const uint32_t first = round.front().first, samples = round.back().first + round.back().count - first;
       const auto count = [&](const RayCounts& c, const Tile& t) {
         counts.add(c);
         rays_done.fetch_add(c.total(), std::memory_order_relaxed);
-        pixels_done.fetch_add(uint64_t(t.pixel_count()) * pass.count, std::memory_order_relaxed);
+        pixels_done.fetch_add(uint64_t(t.pixel_count()) * samples, std::memory_order_relaxed);
       };
       if (session.root()) {
-        TileServer server(tiles, remote_threads, session.size(), pass_serial);
+        TileServer server(tiles, remote_threads, session.size(), round_serial);
         std::exception_ptr own_failure;
         std::thread own([&] {
           try {
             parallel_pull(
                 threads, [&] { return server.take(); },
-                [&](uint32_t i) { count(render_one(accel, ctx, *fb, tiles[i]), tiles[i]); });
+                [&](uint32_t i) { count(render_one(accel, ctx, round, *fb, tiles[i]), tiles[i]); });
           } catch (...) {
             own_failure = std::current_exception();
           }
         });
         try {
-          server.serve(*fb, pass.count);
+          server.serve(*fb, samples);
         } catch (const RankFailed& e) {
           if (progress) progress->stop();
           say("tracer-mpi: error: rank " + std::to_string(e.rank) + " of " + std::to_string(session.size()) + ": " +
@@ -225,14 +244,14 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
         served += server.messages();
         const std::vector<uint64_t> given = server.tiles_per_rank();
         for (size_t r = 0; r < given.size(); ++r) tiles_per_rank[r] += given[r];
-        const uint32_t samples = pass.first + pass.count;
-        if (args.checkpoint && samples < uint32_t(settings.spp) && ms_since(last_write) >= *args.checkpoint * 1e3) {
+        const uint32_t done = first + samples;
+        if (args.checkpoint && done < uint32_t(settings.spp) && ms_since(last_write) >= *args.checkpoint * 1e3) {
           write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
           ++checkpoints;
           last_write = Clock::now();
         }
       } else {
-        TileClient client(tiles, pass_serial);
+        TileClient client(tiles, round_serial);
         try {
           // Each thread renders its tiles into windows of its own and sends them back; its next
           // request is already in flight while it renders.
@@ -245,7 +264,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
             while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
               const Tile& t = tiles[*next];
               result = std::make_unique<Framebuffer>(t);
-              count(render_one(accel, ctx, *result, t), t);
+              count(render_one(accel, ctx, round, *result, t), t);
               finished = *next;
             }
             std::lock_guard lock(report_mutex);
@@ -294,6 +313,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     stats["ranks"] = ranks;
     stats["tiles_per_pass"] = tiles.size();
     stats["passes"] = sample_passes(settings).size() * size_t(args.frames);
+    stats["rounds"] = round_serial;  // rounds of tile distribution (one per pass with --checkpoint)
     stats["rays"]["total"] = all_rays;
     stats["mrays_per_s"] = mine.render_ms > 0 ? double(all_rays) / (mine.render_ms * 1e3) : 0.0;
     stats["checkpoints_written"] = checkpoints;
