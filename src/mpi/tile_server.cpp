@@ -137,34 +137,27 @@ void TileClient::Worker::post_request() {
   MPI_Isend(request_, 2, MPI_INT32_T, 0, pass_tag(client_.serial_, kRequest), MPI_COMM_WORLD, &request_send_);
 }
 
-int32_t TileClient::Worker::wait_answer(double& idle_ms) {
-  const auto t0 = std::chrono::steady_clock::now();
+void TileClient::Worker::complete(MPI_Request& r) {
   Backoff backoff;
   for (;;) {
     int flag = 0;
     {
       std::lock_guard lock(client_.mutex_);
-      MPI_Test(&answer_recv_, &flag, MPI_STATUS_IGNORE);
-    }
-    if (flag) break;
-    backoff.pause();
-  }
-  idle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return answer_;
-}
-
-void TileClient::Worker::wait_send() {
-  Backoff backoff;
-  for (;;) {
-    int flag = 0;
-    {
-      std::lock_guard lock(client_.mutex_);
-      MPI_Test(&result_send_, &flag, MPI_STATUS_IGNORE);
+      MPI_Test(&r, &flag, MPI_STATUS_IGNORE);
     }
     if (flag) return;
     backoff.pause();
   }
 }
+
+int32_t TileClient::Worker::wait_answer(double& idle_ms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  complete(answer_recv_);
+  idle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return answer_;
+}
+
+void TileClient::Worker::wait_send() { complete(result_send_); }
 
 std::optional<uint32_t> TileClient::Worker::next(std::optional<uint32_t> finished, const Framebuffer* sums,
                                                  double& idle_ms) {

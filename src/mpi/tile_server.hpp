@@ -82,6 +82,8 @@ class TileClient {
 
    private:
     void post_request();
+    // Polls `r` (under the client's lock, never held while waiting) until it completes.
+    void complete(MPI_Request& r);
     int32_t wait_answer(double& idle_ms);
     void wait_send();
     TileClient& client_;
