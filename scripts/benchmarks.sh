@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Regenerates every figure behind docs/BENCHMARKS.md on this machine (about 25 minutes on 2 cores):
+# Regenerates every figure behind docs/BENCHMARKS.md on this machine (about 50 minutes on 2 cores):
 # the study's table, the scheduler scaling at 1 and 2 threads, the per-task overhead, our variants
-# with Embree on all scenes, and the Google Benchmark microbenchmarks. Outputs go to docs/bench/.
+# with Embree on all scenes, the Google Benchmark microbenchmarks, then path tracing beside Embree
+# (scripts/benchmarks-path.sh) and tracer-mpi (scripts/benchmarks-mpi.sh). Outputs go to docs/bench/.
 # Run from the project root with ../shared/scenes beside it, on an otherwise idle machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -72,4 +73,8 @@ build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/(Sphere|Wa
 # (single builds on this shared VM vary by several milliseconds; compare minima and medians).
 build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/Bunny/(sah/(seq|tasks)|embree)' \
   --benchmark_repetitions=12 --benchmark_format=console 2>/dev/null | tee "$O/build-bunny.txt"
+# 5. The path tracer: incoherent rays beside Embree, and time to a noise level.
+scripts/benchmarks-path.sh
+# 6. tracer-mpi: the same render as 1 rank x 2 threads and 2 ranks x 1 thread.
+scripts/benchmarks-mpi.sh
 echo "figures written to $O/"
