@@ -43,14 +43,10 @@ class Framebuffer {
     const size_t i = index(x, y);
     return samples_[i] == 0 ? Vec3{0.0f} : sum_[i] / float(samples_[i]);
   }
-  uint32_t samples(int x, int y) const { return samples_[index(x, y)]; }
   // Fewest samples of any pixel: 0 while some pixel has none.
   uint32_t min_samples() const;
-  // Raw access by pixel index (row-major), for moving whole images (gathering ranks' passes).
-  Vec3* sums() { return sum_.data(); }
+  // Raw sums by pixel index (row-major), for sending a window's pixels to another rank.
   const Vec3* sums() const { return sum_.data(); }
-  uint32_t* sample_counts() { return samples_.data(); }
-  const uint32_t* sample_counts() const { return samples_.data(); }
 
  private:
   size_t index(int x, int y) const { return size_t(y - y0_) * size_t(width_) + size_t(x - x0_); }

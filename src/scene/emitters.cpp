@@ -53,11 +53,6 @@ bool Emitters::sample(const Scene& scene, Vec3 from, float u_select, float u1, f
   return std::isfinite(out.pdf);
 }
 
-float Emitters::selection_probability(uint32_t tri) const {
-  const auto it = std::lower_bound(tris_.begin(), tris_.end(), tri);
-  return it != tris_.end() && *it == tri ? pmf_[size_t(it - tris_.begin())] : 0.0f;
-}
-
 float Emitters::pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const {
   const auto it = std::lower_bound(tris_.begin(), tris_.end(), tri);
   if (it == tris_.end() || *it != tri) return 0.0f;

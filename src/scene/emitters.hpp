@@ -35,8 +35,6 @@ class Emitters {
   // The solid-angle density with which sample() picks the point `to` on scene triangle `tri`
   // from `from`: 0 when `tri` is not one of the emitters.
   float pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const;
-  // The probability of choosing scene triangle `tri` (0 if it is not an emitter).
-  float selection_probability(uint32_t tri) const;
 
  private:
   std::vector<uint32_t> tris_;  // scene triangle indices, ascending
