@@ -72,7 +72,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
     for (;;) {
       if (sp == 0) goto done;
       const Entry e = stack[--sp];
-      if (e.t <= hit.t * RayBoxTest::kTieGuard) {
+      if (e.t <= hit.t * SlabGuards::kTieGuard) {
         current = e.node;
         break;
       }

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "accel/lane_kernels.hpp"
 #include "accel/triangle_test.hpp"
 #include "base/enum_names.hpp"
 #include "base/errors.hpp"
@@ -153,20 +154,14 @@ class Bvh {
   std::vector<uint32_t> leaf_of_;      // leaf holding each scene triangle (kInvalidIndex: degenerate)
 };
 
-// Slab test with a per-ray reciprocal direction (Williams et al. 2005, as pbrt does it): a zero
-// direction component gives an infinite reciprocal, and an origin exactly on that slab's plane
-// gives 0*inf = NaN, which the comparisons below drop, so such a slab never culls. Far distances
-// are scaled by 1 + 2*gamma(3) (Ize 2013) so rounding never culls a box the ray touches; the scale
-// is folded into a second reciprocal, which rounds once as the separate multiply did, so the
-// bound is the same and the far chain is one multiply shorter.
-struct RayBoxTest {
-  // Boxes are also kept when entered up to ~16 ulps beyond tfar: a box's entry distance and a
-  // triangle's t round differently, and a triangle hit at exactly the current closest t must
-  // still be reached so ties resolve the same way as in brute force. The guard is relative: a
-  // triangle t whose rounding is larger (t small beside its vertices' distances, hit near an
-  // edge) can still fall below its box's entry; the README states what then differs.
-  static constexpr float kTieGuard = 1.0f + 0x1p-20f;
-  static constexpr float kFarGuard = 1.0f + 2.0f * 3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+// Slab test of one ray against one binary node's box, with a per-ray reciprocal direction
+// (Williams et al. 2005, as pbrt does it); the arithmetic is slab_test's (lane_kernels.hpp).
+// The guards: far distances are scaled by 1 + 2*gamma(3) (Ize 2013) so rounding never culls a box
+// the ray touches, folded into a second reciprocal, which rounds once as the separate multiply
+// did; boxes are kept up to kTieGuard beyond tfar so ties resolve as in brute force. That guard is
+// relative: a triangle t whose rounding is larger (t small beside its vertices' distances, hit near
+// an edge) can still fall below its box's entry; the README states what then differs.
+struct RayBoxTest : SlabGuards {
   float org[3], inv[3], inv_far[3];
   // Byte offsets, within a BvhNode, of the plane each slab enters and leaves by: the ray's
   // direction signs are resolved once here, so the per-node test is loads and arithmetic only.
@@ -189,20 +184,15 @@ struct RayBoxTest {
   // No branch: traversal turns the two children's answers into its next step with arithmetic.
   bool hit(const BvhNode& n, float tnear, float tfar, float& t0_out) const {
     const auto* base = reinterpret_cast<const unsigned char*>(&n);
-    const auto plane = [base](uint32_t off) {
+    const auto plane = [base, this](uint32_t off, int a) {
       float v;
       std::memcpy(&v, base + off, sizeof v);
-      return v;
+      return v - org[a];
     };
-    float t0 = tnear, t1 = tfar * kTieGuard;
-    for (int a = 0; a < 3; ++a) {
-      const float near = (plane(near_off[a]) - org[a]) * inv[a];
-      const float far = (plane(far_off[a]) - org[a]) * inv_far[a];
-      t0 = near > t0 ? near : t0;  // NaN leaves t0 alone
-      t1 = far < t1 ? far : t1;    // NaN leaves t1 alone
-    }
-    t0_out = t0;
-    return t0 <= t1;
+    const Lanes3<float> near{plane(near_off[0], 0), plane(near_off[1], 1), plane(near_off[2], 2)};
+    const Lanes3<float> far{plane(far_off[0], 0), plane(far_off[1], 1), plane(far_off[2], 2)};
+    return slab_test<ScalarLanes>(near, far, {inv[0], inv[1], inv[2]}, {inv_far[0], inv_far[1], inv_far[2]}, tnear,
+                                  tfar, t0_out);
   }
 };
 

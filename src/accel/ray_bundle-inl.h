@@ -15,7 +15,7 @@
 #include <cstdint>
 
 #include "accel/bvh.hpp"
-#include "accel/lane_bits-inl.h"
+#include "accel/simd_lanes-inl.h"
 #include "accel/triangle_test.hpp"
 #include "math/ray_packet.hpp"
 
@@ -28,7 +28,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 // computed for all lanes at once with the scalar constructors' operations (so the same floats).
 struct BundleState {
   HWY_ALIGN float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];    // reciprocal direction
-  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times RayBoxTest::kFarGuard
+  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times SlabGuards::kFarGuard
   HWY_ALIGN int32_t nx[kPacketSize], ny[kPacketSize], nz[kPacketSize];  // -1 where that reciprocal is negative
   HWY_ALIGN int32_t kx[kPacketSize], ky[kPacketSize], kz[kPacketSize];  // RayShear's axes ...
   HWY_ALIGN float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];    // ... and factors
@@ -40,7 +40,7 @@ struct BundleState {
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;
     const size_t N = hn::Lanes(d);
-    const auto one = hn::Set(d, 1.0f), guard = hn::Set(d, RayBoxTest::kFarGuard), zero = hn::Zero(d);
+    const auto one = hn::Set(d, 1.0f), guard = hn::Set(d, SlabGuards::kFarGuard), zero = hn::Zero(d);
     const auto i0 = hn::Zero(di), i1 = hn::Set(di, 1), i2 = hn::Set(di, 2);
     for (size_t i = 0; i < size_t(kPacketSize); i += N) {
       const auto dx = hn::Load(d, rays.dx + i), dy = hn::Load(d, rays.dy + i), dz = hn::Load(d, rays.dz + i);
@@ -95,17 +95,18 @@ struct BundleState {
   }
 };
 
-// The lanes of `mask` whose rays enter the box [lo, hi] within [tnear, tfar]: RayBoxTest's
-// arithmetic per lane, with plane - origin (the origin is shared) computed once per plane.
+// The lanes of `mask` whose rays enter the box [lo, hi] within [tnear, tfar]: lane_kernels-inl.h's
+// slab test, one lane per ray, with plane - origin (the origin is shared) computed once per plane.
 HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const BundleState& st, uint32_t mask) {
   const hn::ScalableTag<float> d;
+  using L = SimdLanes<decltype(d)>;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const auto lo_x = hn::Set(d, lo[0] - st.org[0]), lo_y = hn::Set(d, lo[1] - st.org[1]),
              lo_z = hn::Set(d, lo[2] - st.org[2]);
   const auto hi_x = hn::Set(d, hi[0] - st.org[0]), hi_y = hn::Set(d, hi[1] - st.org[1]),
              hi_z = hn::Set(d, hi[2] - st.org[2]);
-  const auto tnear = hn::Set(d, st.tnear), tfar = hn::Set(d, st.tfar * RayBoxTest::kTieGuard);
+  const auto tnear = hn::Set(d, st.tnear), tfar = hn::Set(d, st.tfar);
   uint32_t hits = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
@@ -113,40 +114,32 @@ HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const Bu
     const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nx + i), hn::Zero(di)));
     const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
     const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nz + i), hn::Zero(di)));
-    const auto a = hn::Mul(hn::IfThenElse(negx, hi_x, lo_x), hn::Load(d, st.ix + i));
-    const auto b = hn::Mul(hn::IfThenElse(negy, hi_y, lo_y), hn::Load(d, st.iy + i));
-    const auto c = hn::Mul(hn::IfThenElse(negz, hi_z, lo_z), hn::Load(d, st.iz + i));
-    auto t0 = tnear;
-    t0 = hn::IfThenElse(hn::Gt(a, t0), a, t0);  // NaN compares false: no cull, as in RayBoxTest
-    t0 = hn::IfThenElse(hn::Gt(b, t0), b, t0);
-    t0 = hn::IfThenElse(hn::Gt(c, t0), c, t0);
-    const auto e = hn::Mul(hn::IfThenElse(negx, lo_x, hi_x), hn::Load(d, st.fx + i));
-    const auto f = hn::Mul(hn::IfThenElse(negy, lo_y, hi_y), hn::Load(d, st.fy + i));
-    const auto g = hn::Mul(hn::IfThenElse(negz, lo_z, hi_z), hn::Load(d, st.fz + i));
-    auto t1 = tfar;
-    t1 = hn::IfThenElse(hn::Lt(e, t1), e, t1);
-    t1 = hn::IfThenElse(hn::Lt(f, t1), f, t1);
-    t1 = hn::IfThenElse(hn::Lt(g, t1), g, t1);
-    hits |= Bits(d, hn::And(hn::Le(t0, t1), LaneMask(d, chunk))) << i;
+    const Lanes3<L::V> near{hn::IfThenElse(negx, hi_x, lo_x), hn::IfThenElse(negy, hi_y, lo_y),
+                            hn::IfThenElse(negz, hi_z, lo_z)};
+    const Lanes3<L::V> far{hn::IfThenElse(negx, lo_x, hi_x), hn::IfThenElse(negy, lo_y, hi_y),
+                           hn::IfThenElse(negz, lo_z, hi_z)};
+    const Lanes3<L::V> inv{hn::Load(d, st.ix + i), hn::Load(d, st.iy + i), hn::Load(d, st.iz + i)};
+    const Lanes3<L::V> inv_far{hn::Load(d, st.fx + i), hn::Load(d, st.fy + i), hn::Load(d, st.fz + i)};
+    L::V t0;
+    hits |= Bits(d, hn::And(slab_test<L>(near, far, inv, inv_far, tnear, tfar, t0), LaneMask(d, chunk))) << i;
   }
   return hits;
 }
 
 // The lanes of `mask` whose rays hit triangle `tri` (vertices v0, v1, v2; `tri` itself is only
-// read for lanes the float test cannot decide): triangle_test.hpp's watertight test, one lane per
-// ray. The origin is shared, so vertex - origin is one scalar per coordinate, and each lane picks
-// its shear axes from those with selects; every lane then runs the scalar test's operations in
-// its order, so its answer is the scalar test's. Lanes with an edge function exactly zero are
+// read for lanes the float test cannot decide): lane_kernels-inl.h's watertight test, one lane
+// per ray. The origin is shared, so vertex - origin is one scalar per coordinate, and each lane
+// picks its shear axes from those with selects. Lanes with an edge function exactly zero are
 // redone by the scalar test, which decides them in double.
 HWY_INLINE uint32_t OccludedByTriangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Triangle& tri,
                                        const BundleState& st, uint32_t mask) {
   const hn::ScalableTag<float> d;
+  using L = SimdLanes<decltype(d)>;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const float a[3] = {v0.x - st.org[0], v0.y - st.org[1], v0.z - st.org[2]};
   const float b[3] = {v1.x - st.org[0], v1.y - st.org[1], v1.z - st.org[2]};
   const float c[3] = {v2.x - st.org[0], v2.y - st.org[1], v2.z - st.org[2]};
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
   const auto tnear = hn::Set(d, st.tnear), tfar = hn::Set(d, st.tfar);
   const auto zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
   uint32_t hits = 0;
@@ -159,29 +152,17 @@ HWY_INLINE uint32_t OccludedByTriangle(const Vec3& v0, const Vec3& v1, const Vec
                             hn::IfThenElse(hn::RebindMask(d, hn::Eq(k, one_i)), hn::Set(d, v[1]), hn::Set(d, v[2])));
     };
     const auto kx = hn::Load(di, st.kx + i), ky = hn::Load(di, st.ky + i), kz = hn::Load(di, st.kz + i);
-    const auto sx = hn::Load(d, st.sx + i), sy = hn::Load(d, st.sy + i), sz = hn::Load(d, st.sz + i);
-    const auto akz = pick(a, kz), bkz = pick(b, kz), ckz = pick(c, kz);
-    const auto ax = hn::Sub(pick(a, kx), hn::Mul(sx, akz)), ay = hn::Sub(pick(a, ky), hn::Mul(sy, akz));
-    const auto bx = hn::Sub(pick(b, kx), hn::Mul(sx, bkz)), by = hn::Sub(pick(b, ky), hn::Mul(sy, bkz));
-    const auto cx = hn::Sub(pick(c, kx), hn::Mul(sx, ckz)), cy = hn::Sub(pick(c, ky), hn::Mul(sy, ckz));
-    const auto u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-    const auto v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-    const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    const auto vertex = [&](const float* v) { return Lanes3<L::V>{pick(v, kx), pick(v, ky), pick(v, kz)}; };
+    const ShearedTriangle<L::V> s =
+        shear_triangle<L>(vertex(a), vertex(b), vertex(c), hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
     const auto lanes = LaneMask(d, chunk);
-    const auto neg = hn::Or(hn::Or(hn::Lt(u, zero), hn::Lt(v, zero)), hn::Lt(w, zero));
-    const auto pos = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
-    const auto on_edge = hn::And(lanes, hn::Or(hn::Or(hn::Eq(u, zero), hn::Eq(v, zero)), hn::Eq(w, zero)));
+    const auto on_edge = hn::And(lanes, on_an_edge<L>(s));
     uint32_t edge = Bits(d, on_edge);
-    const auto inside = hn::AndNot(hn::And(neg, pos), hn::AndNot(on_edge, lanes));
+    const auto outside = passes_outside<L>(s);
+    const auto inside = hn::AndNot(outside, hn::AndNot(on_edge, lanes));
     if (!hn::AllFalse(d, inside)) {
-      const auto det = hn::Add(hn::Add(u, v), w);
-      const auto rcp = hn::Div(one, det);
-      const auto t = hn::Mul(
-          hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, akz)), hn::Mul(v, hn::Mul(sz, bkz))), hn::Mul(w, hn::Mul(sz, ckz))),
-          rcp);
-      const auto hit = hn::And(hn::AndNot(hn::Eq(det, zero), inside),
-                               hn::And(hn::And(hn::Ge(t, tnear), hn::Le(t, tfar)), hn::Lt(t, inf)));
-      hits |= Bits(d, hit) << i;
+      const TriangleLanes<L> h = triangle_hit<L>(s, outside, hn::Load(d, st.sz + i), tnear, tfar);
+      hits |= Bits(d, hn::And(h.hit, inside)) << i;
     }
     for (; edge; edge &= edge - 1) {  // exactly on an edge in float: the scalar test decides
       const int k = int(i) + __builtin_ctz(edge);

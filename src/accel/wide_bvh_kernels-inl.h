@@ -1,6 +1,6 @@
-// The 8-wide BVH's per-ray building blocks, compiled once per SIMD target: the slab test of all
-// eight children at once, the watertight triangle test over a pack of eight triangles, the
-// choice of the next child, and any-hit below a node. Shared by the single-ray kernels
+// The 8-wide BVH's per-ray building blocks, compiled once per SIMD target: lane_kernels' slab
+// test over all eight children at once and its watertight test over a pack of eight triangles,
+// the choice of the next child, and any-hit below a node. Shared by the single-ray kernels
 // (wide_bvh_traverse.cpp), the AO bundles (wide_bvh_bundles.cpp) and SIMD brute force
 // (simd_brute_force.cpp). Include it after foreach_target.h; the guard toggles per target as
 // Highway's -inl.h convention requires.
@@ -18,6 +18,7 @@
 #include <cmath>
 #include <limits>
 
+#include "accel/simd_lanes-inl.h"
 #include "accel/triangle_test.hpp"
 #include "accel/wide_bvh.hpp"
 
@@ -36,39 +37,21 @@ struct WideRay {
     ix = 1.0f / r.dir.x;
     iy = 1.0f / r.dir.y;
     iz = 1.0f / r.dir.z;
-    fx = ix * RayBoxTest::kFarGuard;
-    fy = iy * RayBoxTest::kFarGuard;
-    fz = iz * RayBoxTest::kFarGuard;
+    fx = ix * SlabGuards::kFarGuard;
+    fy = iy * SlabGuards::kFarGuard;
+    fz = iz * SlabGuards::kFarGuard;
     nx = std::signbit(ix);
     ny = std::signbit(iy);
     nz = std::signbit(iz);
   }
 };
 
-// max(a, b) and min(a, b) that keep b when a is NaN: x86's maxps/minps return their second
-// operand whenever either is NaN, which is exactly the slab test's rule (NaN never culls), in
-// one instruction instead of a compare and a blend. Other targets spell the rule out.
-template <class V>
-HWY_INLINE V MaxOrSecond(V a, V b) {
-#if HWY_ARCH_X86 && HWY_TARGET != HWY_EMU128 && HWY_TARGET != HWY_SCALAR
-  return hn::Max(a, b);
-#else
-  return hn::IfThenElse(a > b, a, b);
-#endif
-}
-template <class V>
-HWY_INLINE V MinOrSecond(V a, V b) {
-#if HWY_ARCH_X86 && HWY_TARGET != HWY_EMU128 && HWY_TARGET != HWY_SCALAR
-  return hn::Min(a, b);
-#else
-  return hn::IfThenElse(a < b, a, b);
-#endif
-}
-
-// Tests all children of `n`; writes their entry distances to t_out and returns one bit per child hit.
+// Tests all children of `n` (lane_kernels-inl.h's slab test, one lane per child); writes their
+// entry distances to t_out and returns one bit per child hit.
 HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar,
                                  float* HWY_RESTRICT t_out) {
   const hn::CappedTag<float, kWideWidth> d;
+  using L = SimdLanes<decltype(d)>;
   const size_t lanes = hn::Lanes(d);
   const float* near_x = r.nx ? n.hi_x : n.lo_x;
   const float* far_x = r.nx ? n.lo_x : n.hi_x;
@@ -77,94 +60,66 @@ HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnea
   const float* near_z = r.nz ? n.hi_z : n.lo_z;
   const float* far_z = r.nz ? n.lo_z : n.hi_z;
   const auto ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
-  const auto ix = hn::Set(d, r.ix), iy = hn::Set(d, r.iy), iz = hn::Set(d, r.iz);
-  const auto fx = hn::Set(d, r.fx), fy = hn::Set(d, r.fy), fz = hn::Set(d, r.fz);
-  const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar * RayBoxTest::kTieGuard);
+  const Lanes3<L::V> inv{hn::Set(d, r.ix), hn::Set(d, r.iy), hn::Set(d, r.iz)};
+  const Lanes3<L::V> inv_far{hn::Set(d, r.fx), hn::Set(d, r.fy), hn::Set(d, r.fz)};
+  const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar);
   uint32_t bits = 0;
   for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
-    auto t0 = vnear, t1 = vfar;
-    const auto a = hn::Mul(hn::Sub(hn::Load(d, near_x + i), ox), ix);
-    const auto b = hn::Mul(hn::Sub(hn::Load(d, near_y + i), oy), iy);
-    const auto c = hn::Mul(hn::Sub(hn::Load(d, near_z + i), oz), iz);
-    t0 = MaxOrSecond(a, t0);  // NaN leaves t0 alone: no cull
-    t0 = MaxOrSecond(b, t0);
-    t0 = MaxOrSecond(c, t0);
-    const auto e = hn::Mul(hn::Sub(hn::Load(d, far_x + i), ox), fx);
-    const auto f = hn::Mul(hn::Sub(hn::Load(d, far_y + i), oy), fy);
-    const auto g = hn::Mul(hn::Sub(hn::Load(d, far_z + i), oz), fz);
-    t1 = MinOrSecond(e, t1);
-    t1 = MinOrSecond(f, t1);
-    t1 = MinOrSecond(g, t1);
+    const Lanes3<L::V> near{hn::Load(d, near_x + i) - ox, hn::Load(d, near_y + i) - oy, hn::Load(d, near_z + i) - oz};
+    const Lanes3<L::V> far{hn::Load(d, far_x + i) - ox, hn::Load(d, far_y + i) - oy, hn::Load(d, far_z + i) - oz};
+    L::V t0;
+    const auto hit = slab_test<L>(near, far, inv, inv_far, vnear, vfar, t0);
     hn::Store(t0, d, t_out + i);
-    uint8_t mask_bits[8] = {0};
-    hn::StoreMaskBits(d, t0 <= t1, mask_bits);
-    bits |= uint32_t(mask_bits[0]) << i;
+    bits |= Bits(d, hit) << i;
   }
   return bits;
 }
 
-// One ray against the triangles of `pack`, lane-parallel: the watertight test of
-// triangle_test.hpp with the same operations in the same order, so each lane's t, u, v equal
-// the scalar test's bit for bit. Lanes whose edge function is exactly zero are redone by the
-// scalar test (which decides them in double), as are none in the common case.
-// Returns the mask of lanes hit within [tnear, tfar]; their t, u, v go to the arrays.
+// One ray against the triangles of `pack`, one lane per triangle: lane_kernels-inl.h's
+// watertight test, so each lane's t, u, v equal the scalar test's bit for bit. Lanes whose edge
+// function is exactly zero are redone by the scalar test (which decides them in double), as are
+// none in the common case. Returns the mask of lanes hit within [tnear, tfar]; their t, u, v go
+// to the arrays.
 HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, const Triangle* tris, float tnear,
                                   float tfar, float* HWY_RESTRICT t_out, float* HWY_RESTRICT u_out,
                                   float* HWY_RESTRICT v_out) {
   const hn::CappedTag<float, kWideWidth> d;
+  using L = SimdLanes<decltype(d)>;
   const size_t lanes = hn::Lanes(d);
   const float org[3] = {s.org.x, s.org.y, s.org.z};
   const auto okx = hn::Set(d, org[s.kx]), oky = hn::Set(d, org[s.ky]), okz = hn::Set(d, org[s.kz]);
   const auto sx = hn::Set(d, s.sx), sy = hn::Set(d, s.sy), sz = hn::Set(d, s.sz);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
   const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar);
+  const auto vertex = [&](int k, size_t i) {
+    return Lanes3<L::V>{hn::Load(d, p.v[k][s.kx] + i) - okx, hn::Load(d, p.v[k][s.ky] + i) - oky,
+                        hn::Load(d, p.v[k][s.kz] + i) - okz};
+  };
   uint32_t bits = 0;
   for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
-    const auto ax_ = hn::Sub(hn::Load(d, p.v[0][s.kx] + i), okx), ay_ = hn::Sub(hn::Load(d, p.v[0][s.ky] + i), oky),
-               az_ = hn::Sub(hn::Load(d, p.v[0][s.kz] + i), okz);
-    const auto bx_ = hn::Sub(hn::Load(d, p.v[1][s.kx] + i), okx), by_ = hn::Sub(hn::Load(d, p.v[1][s.ky] + i), oky),
-               bz_ = hn::Sub(hn::Load(d, p.v[1][s.kz] + i), okz);
-    const auto cx_ = hn::Sub(hn::Load(d, p.v[2][s.kx] + i), okx), cy_ = hn::Sub(hn::Load(d, p.v[2][s.ky] + i), oky),
-               cz_ = hn::Sub(hn::Load(d, p.v[2][s.kz] + i), okz);
-    const auto ax = hn::Sub(ax_, hn::Mul(sx, az_)), ay = hn::Sub(ay_, hn::Mul(sy, az_));
-    const auto bx = hn::Sub(bx_, hn::Mul(sx, bz_)), by = hn::Sub(by_, hn::Mul(sy, bz_));
-    const auto cx = hn::Sub(cx_, hn::Mul(sx, cz_)), cy = hn::Sub(cy_, hn::Mul(sy, cz_));
-    const auto u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-    const auto v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-    const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
-    const auto neg = hn::Or(hn::Or(u < zero, v < zero), w < zero);
-    const auto pos = hn::Or(hn::Or(u > zero, v > zero), w > zero);
-    const auto on_edge = hn::Or(hn::Or(u == zero, v == zero), w == zero);
+    const ShearedTriangle<L::V> st = shear_triangle<L>(vertex(0, i), vertex(1, i), vertex(2, i), sx, sy);
+    const auto on_edge = on_an_edge<L>(st);
+    const auto outside = passes_outside<L>(st);
     // Most packs a ray reaches it misses entirely: then skip the division and the stores.
-    if (hn::AllTrue(d, hn::AndNot(on_edge, hn::And(neg, pos)))) continue;
-    const auto det = hn::Add(hn::Add(u, v), w);
-    const auto rcp = hn::Div(one, det);
-    const auto t = hn::Mul(
-        hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))),
-        rcp);
-    auto hit = hn::AndNot(hn::And(neg, pos), det != zero);
-    hit = hn::And(hit, hn::And(hn::And(t >= vnear, t <= vfar), t < inf));
-    hn::Store(t, d, t_out + i);
-    hn::Store(hn::Mul(v, rcp), d, u_out + i);
-    hn::Store(hn::Mul(w, rcp), d, v_out + i);
-    uint8_t hit_bits[8] = {0}, edge_bits[8] = {0};
-    hn::StoreMaskBits(d, hit, hit_bits);
-    hn::StoreMaskBits(d, on_edge, edge_bits);
-    uint32_t h = hit_bits[0], edge = edge_bits[0];
+    if (hn::AllTrue(d, hn::AndNot(on_edge, outside))) continue;
+    const TriangleLanes<L> h = triangle_hit<L>(st, outside, sz, vnear, vfar);
+    hn::Store(h.t, d, t_out + i);
+    hn::Store(h.u, d, u_out + i);
+    hn::Store(h.v, d, v_out + i);
+    uint32_t hit = Bits(d, h.hit), edge = Bits(d, on_edge);
     while (edge) {  // exactly on an edge in float: let the scalar test decide in double
       const int k = __builtin_ctz(edge);
       edge &= edge - 1;
       const uint32_t id = p.id[i + size_t(k)];
       TriangleHit th;
-      h &= ~(1u << k);
+      hit &= ~(1u << k);
       if (id != kInvalidIndex && intersect_triangle(s, tris[id], tnear, tfar, th)) {
-        h |= 1u << k;
+        hit |= 1u << k;
         t_out[i + size_t(k)] = th.t;
         u_out[i + size_t(k)] = th.u;
         v_out[i + size_t(k)] = th.v;
       }
     }
-    bits |= h << i;
+    bits |= hit << i;
   }
   return bits;
 }

@@ -13,7 +13,7 @@
 
 #include <cmath>
 
-#include "accel/lane_bits-inl.h"
+#include "accel/simd_lanes-inl.h"
 #include "accel/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
@@ -25,7 +25,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 struct PacketState {
   HWY_ALIGN float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
   HWY_ALIGN float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];    // reciprocal direction
-  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times RayBoxTest::kFarGuard
+  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times SlabGuards::kFarGuard
   HWY_ALIGN int32_t nx[kPacketSize], ny[kPacketSize], nz[kPacketSize];  // -1 where that reciprocal is negative
   HWY_ALIGN float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];    // shear constants (RayShear)
   HWY_ALIGN float tnear[kPacketSize];
@@ -45,11 +45,11 @@ constexpr int32_t kFlip = INT32_MIN;
 // coherent packet one ray's order is the packet's, and it costs no reduction across lanes).
 HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState& st, uint32_t mask, float& entry) {
   const hn::ScalableTag<float> d;
+  using L = SimdLanes<decltype(d)>;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const auto lo_x = hn::Set(d, n.lo_x[c]), lo_y = hn::Set(d, n.lo_y[c]), lo_z = hn::Set(d, n.lo_z[c]);
   const auto hi_x = hn::Set(d, n.hi_x[c]), hi_y = hn::Set(d, n.hi_y[c]), hi_z = hn::Set(d, n.hi_z[c]);
-  const auto tie = hn::Set(d, RayBoxTest::kTieGuard);
   HWY_ALIGN float t0s[kPacketSize];
   uint32_t hits = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
@@ -59,22 +59,15 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
     const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
     const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nz + i), hn::Zero(di)));
     const auto ox = hn::Load(d, st.ox + i), oy = hn::Load(d, st.oy + i), oz = hn::Load(d, st.oz + i);
-    const auto ix = hn::Load(d, st.ix + i), iy = hn::Load(d, st.iy + i), iz = hn::Load(d, st.iz + i);
-    auto t0 = hn::Load(d, st.tnear + i);
-    auto t1 = hn::Mul(hn::Load(d, st.t + i), tie);
-    const auto a = hn::Mul(hn::Sub(hn::IfThenElse(negx, hi_x, lo_x), ox), ix);
-    const auto b = hn::Mul(hn::Sub(hn::IfThenElse(negy, hi_y, lo_y), oy), iy);
-    const auto e = hn::Mul(hn::Sub(hn::IfThenElse(negz, hi_z, lo_z), oz), iz);
-    t0 = hn::IfThenElse(hn::Gt(a, t0), a, t0);  // NaN compares false: no cull, as in RayBoxTest
-    t0 = hn::IfThenElse(hn::Gt(b, t0), b, t0);
-    t0 = hn::IfThenElse(hn::Gt(e, t0), e, t0);
-    const auto f = hn::Mul(hn::Sub(hn::IfThenElse(negx, lo_x, hi_x), ox), hn::Load(d, st.fx + i));
-    const auto g = hn::Mul(hn::Sub(hn::IfThenElse(negy, lo_y, hi_y), oy), hn::Load(d, st.fy + i));
-    const auto h = hn::Mul(hn::Sub(hn::IfThenElse(negz, lo_z, hi_z), oz), hn::Load(d, st.fz + i));
-    t1 = hn::IfThenElse(hn::Lt(f, t1), f, t1);
-    t1 = hn::IfThenElse(hn::Lt(g, t1), g, t1);
-    t1 = hn::IfThenElse(hn::Lt(h, t1), h, t1);
-    const auto hit = hn::And(hn::Le(t0, t1), LaneMask(d, chunk));
+    const Lanes3<L::V> near{hn::IfThenElse(negx, hi_x, lo_x) - ox, hn::IfThenElse(negy, hi_y, lo_y) - oy,
+                            hn::IfThenElse(negz, hi_z, lo_z) - oz};
+    const Lanes3<L::V> far{hn::IfThenElse(negx, lo_x, hi_x) - ox, hn::IfThenElse(negy, lo_y, hi_y) - oy,
+                           hn::IfThenElse(negz, lo_z, hi_z) - oz};
+    const Lanes3<L::V> inv{hn::Load(d, st.ix + i), hn::Load(d, st.iy + i), hn::Load(d, st.iz + i)};
+    const Lanes3<L::V> inv_far{hn::Load(d, st.fx + i), hn::Load(d, st.fy + i), hn::Load(d, st.fz + i)};
+    L::V t0;
+    const auto enters = slab_test<L>(near, far, inv, inv_far, hn::Load(d, st.tnear + i), hn::Load(d, st.t + i), t0);
+    const auto hit = hn::And(enters, LaneMask(d, chunk));
     if (hn::AllFalse(d, hit)) continue;
     hits |= Bits(d, hit) << i;
     hn::Store(t0, d, t0s + i);
@@ -88,6 +81,7 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
 HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, PacketState& st,
                                         uint32_t mask) {
   const hn::ScalableTag<float> d;
+  using L = SimdLanes<decltype(d)>;
   const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const uint32_t tri = p.id[k];
@@ -95,42 +89,30 @@ HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Tria
   const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
   const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
   const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), inf = hn::Set(d, kInfinity);
   const auto vid = hn::Set(di, id);
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
     const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
-    const auto sx = hn::Load(d, st.sx + i), sy = hn::Load(d, st.sy + i), sz = hn::Load(d, st.sz + i);
-    const auto az_ = hn::Sub(az0, okz), bz_ = hn::Sub(bz0, okz), cz_ = hn::Sub(cz0, okz);
-    const auto ax = hn::Sub(hn::Sub(ax0, okx), hn::Mul(sx, az_)), ay = hn::Sub(hn::Sub(ay0, oky), hn::Mul(sy, az_));
-    const auto bx = hn::Sub(hn::Sub(bx0, okx), hn::Mul(sx, bz_)), by = hn::Sub(hn::Sub(by0, oky), hn::Mul(sy, bz_));
-    const auto cx = hn::Sub(hn::Sub(cx0, okx), hn::Mul(sx, cz_)), cy = hn::Sub(hn::Sub(cy0, oky), hn::Mul(sy, cz_));
-    const auto u = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-    const auto v = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-    const auto w = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
-    const auto neg = hn::Or(hn::Or(hn::Lt(u, zero), hn::Lt(v, zero)), hn::Lt(w, zero));
-    const auto pos = hn::Or(hn::Or(hn::Gt(u, zero), hn::Gt(v, zero)), hn::Gt(w, zero));
-    const auto det = hn::Add(hn::Add(u, v), w);
-    const auto rcp = hn::Div(one, det);
-    const auto t = hn::Mul(
-        hn::Add(hn::Add(hn::Mul(u, hn::Mul(sz, az_)), hn::Mul(v, hn::Mul(sz, bz_))), hn::Mul(w, hn::Mul(sz, cz_))),
-        rcp);
+    const ShearedTriangle<L::V> s =
+        shear_triangle<L>({ax0 - okx, ay0 - oky, az0 - okz}, {bx0 - okx, by0 - oky, bz0 - okz},
+                          {cx0 - okx, cy0 - oky, cz0 - okz}, hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
     const auto best_t = hn::Load(d, st.t + i);
     const auto best_id = hn::Load(di, st.tri + i);
-    auto hit = hn::AndNot(hn::And(neg, pos), hn::Ne(det, zero));
-    hit = hn::And(hit, hn::And(hn::And(hn::Ge(t, hn::Load(d, st.tnear + i)), hn::Le(t, best_t)), hn::Lt(t, inf)));
+    const TriangleLanes<L> found =
+        triangle_hit<L>(s, passes_outside<L>(s), hn::Load(d, st.sz + i), hn::Load(d, st.tnear + i), best_t);
     // closer(): nearer t wins; equal t goes to the lower scene index.
-    hit = hn::And(hit, hn::Or(hn::Lt(t, best_t), hn::And(hn::Eq(t, best_t), hn::RebindMask(d, hn::Lt(vid, best_id)))));
+    auto hit = hn::And(found.hit, hn::Or(hn::Lt(found.t, best_t),
+                                         hn::And(hn::Eq(found.t, best_t), hn::RebindMask(d, hn::Lt(vid, best_id)))));
     hit = hn::And(hit, LaneMask(d, chunk));
     // Lanes exactly on an edge in float are decided by the scalar test in double, as they would
     // be for that ray alone; their vector result is dropped.
-    const auto on_edge = hn::Or(hn::Or(hn::Eq(u, zero), hn::Eq(v, zero)), hn::Eq(w, zero));
+    const auto on_edge = on_an_edge<L>(s);
     hit = hn::AndNot(on_edge, hit);
     const auto keep = hn::Not(hit);
-    hn::Store(hn::IfThenElse(keep, best_t, t), d, st.t + i);
-    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.u + i), hn::Mul(v, rcp)), d, st.u + i);
-    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.v + i), hn::Mul(w, rcp)), d, st.v + i);
+    hn::Store(hn::IfThenElse(keep, best_t, found.t), d, st.t + i);
+    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.u + i), found.u), d, st.u + i);
+    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.v + i), found.v), d, st.v + i);
     hn::Store(hn::IfThenElse(hn::RebindMask(di, keep), best_id, vid), di, st.tri + i);
     for (uint32_t bits = Bits(d, on_edge) & chunk; bits; bits &= bits - 1) {
       const size_t lane = i + size_t(__builtin_ctz(bits));

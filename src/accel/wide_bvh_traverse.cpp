@@ -36,7 +36,7 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
     do {
       if (sp == 0) return finish_hit(bvh.scene(), hit);
       cur = stack[--sp];
-    } while (!(cur.t <= hit.t * RayBoxTest::kTieGuard));
+    } while (!(cur.t <= hit.t * SlabGuards::kTieGuard));
   }
 }
 
