@@ -333,6 +333,17 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   bool any_normal = false, any_uv = false;
   std::vector<Vec3> corner_normals;
   std::vector<Vec2> corner_uvs;
+  // Sized once: growing six arrays by doubling cost a third of this function on large scenes.
+  size_t triangle_faces = 0;
+  for (const tinyobj::shape_t& shape : parsed.shapes) {
+    for (const unsigned int fv : shape.mesh.num_face_vertices) triangle_faces += fv == 3 ? 1 : 0;
+  }
+  corner_normals.reserve(3 * triangle_faces);
+  corner_uvs.reserve(3 * triangle_faces);
+  scene.triangles.reserve(triangle_faces);
+  scene.tri_prim.reserve(triangle_faces);
+  scene.tri_geom.reserve(triangle_faces);
+  scene.tri_material.reserve(triangle_faces);
   for (const tinyobj::shape_t& shape : parsed.shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     Geometry g;
