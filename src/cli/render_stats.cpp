@@ -1,8 +1,21 @@
 #include "cli/render_stats.hpp"
 
+#include <sys/resource.h>
+
 #include <cstdio>
 
 namespace tracer::cli {
+
+namespace {
+
+// The process's peak resident memory so far, MiB (Linux reports ru_maxrss in KiB).
+double peak_rss_mib() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return double(usage.ru_maxrss) / 1024.0;
+}
+
+}  // namespace
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
@@ -33,6 +46,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
             {"total", rays.total()}}},
           {"mrays_per_s", mrays},
           {"accel_bytes", accel.memory_bytes()},
+          {"peak_rss_mib", peak_rss_mib()},
           {"output", args.output}};
 }
 
@@ -53,6 +67,8 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
               : accel.kind == AccelKind::Bvh8   ? ", primary rays in 4x4 packets, AO rays in bundles"
               : accel.kind == AccelKind::Embree ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
                                                 : ", AO rays in bundles");
+  std::printf("memory       %.1f MiB accelerator, %.1f MiB peak resident (scene, accelerator, image)\n",
+              double(j["accel_bytes"].get<size_t>()) / (1024.0 * 1024.0), j["peak_rss_mib"].get<double>());
   if (const std::optional<BvhStats> st = accel.bvh_stats()) {
     std::printf("bvh          %zu nodes, %zu leaves (%.2f triangles avg, %zu max), depth %zu, SAH cost %.2f\n",
                 st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
