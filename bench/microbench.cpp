@@ -13,10 +13,13 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "render/ao.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
+#include "scene/views.hpp"
+#include "shade/sampling.hpp"
 
 namespace tracer {
 namespace {
@@ -138,6 +141,133 @@ void BM_BoxTest(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(nodes.size()));
 }
 BENCHMARK(BM_BoxTest);
+
+// Incoherent rays on the views people render (views.tsv): at each primary hit of a 256x256
+// image, one diffuse bounce (cosine-distributed about the normal, closest hit: what a path
+// tracer's second ray is) and 16 AO rays (the study's directions, any hit), all leaving the
+// surface as the renderer's rays do.
+struct IncoherentRays {
+  std::string name;
+  std::shared_ptr<Scene> scene;
+  std::vector<Ray> bounce, ao;
+};
+
+IncoherentRays record_incoherent(const View& view) {
+  IncoherentRays out;
+  out.name = view.name;
+  out.scene = std::make_shared<Scene>(load_obj(view.obj, [](const std::string&) {}));
+  const Bvh bvh(*out.scene, BvhBuildOptions{});
+  constexpr int kSize = 256;
+  const Camera camera(view.camera, kSize, kSize);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const Ray primary = camera.primary_ray(x, y);
+      Hit hit;
+      if (!bvh.intersect(primary, hit)) continue;
+      const Triangle& tri = out.scene->triangles[hit.tri];
+      Vec3 n = normalize(tri.normal());
+      if (dot(n, primary.dir) > 0.0f) n = -n;
+      const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
+      Ray r;
+      r.org = offset_origin(p, n);
+      const uint32_t pixel = uint32_t(y * kSize + x);
+      const SampleRng bounce_rng(pixel, 0, 1);
+      r.dir = Frame(n).to_world(cosine_hemisphere(bounce_rng.draw(0), bounce_rng.draw(1)));
+      out.bounce.push_back(r);
+      for (uint32_t i = 0; i < 16; ++i) {
+        const SampleRng rng(pixel, i);
+        r.dir = ao_direction(n, rng.draw(0), rng.draw(1));
+        out.ao.push_back(r);
+      }
+    }
+  }
+  return out;
+}
+
+// The order a ray stream is traced in after sorting, per batch: direction octant first, then the
+// origin's Morton code on a 1024^3 grid over the scene's bounds (rays that start close and go the
+// same way walk the same nodes).
+std::vector<uint32_t> sorted_order(const std::vector<Ray>& rays, size_t begin, size_t end, const Aabb& bounds) {
+  const auto spread = [](uint32_t v) {  // 10 bits to every third of 30
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x30000ffu;
+    v = (v | (v << 8)) & 0x300f00fu;
+    v = (v | (v << 4)) & 0x30c30c3u;
+    return (v | (v << 2)) & 0x9249249u;
+  };
+  const Vec3 extent = max(bounds.hi - bounds.lo, Vec3{1e-20f});
+  const Vec3 scale{1023.0f / extent.x, 1023.0f / extent.y, 1023.0f / extent.z};
+  std::vector<uint64_t> keys(end - begin);
+  for (size_t i = begin; i < end; ++i) {
+    const Ray& r = rays[i];
+    const Vec3 d = r.org - bounds.lo;
+    const Vec3 q = min(max(Vec3{d.x * scale.x, d.y * scale.y, d.z * scale.z}, Vec3{0.0f}), Vec3{1023.0f});
+    const uint32_t octant = uint32_t(r.dir.x < 0) | uint32_t(r.dir.y < 0) << 1 | uint32_t(r.dir.z < 0) << 2;
+    const uint32_t morton = spread(uint32_t(q.x)) | spread(uint32_t(q.y)) << 1 | spread(uint32_t(q.z)) << 2;
+    keys[i - begin] = uint64_t(octant) << 61 | uint64_t(morton) << 31 | uint64_t(i - begin);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<uint32_t> order(keys.size());
+  for (size_t k = 0; k < keys.size(); ++k) order[k] = uint32_t(begin + (keys[k] & 0x7fffffffu));
+  return order;
+}
+
+void register_incoherent() {
+  const std::string views_path = std::string(TRACER_SCENES_DIR) + "/views.tsv";
+  if (!std::filesystem::exists(views_path)) return;
+  static std::vector<IncoherentRays> all;
+  for (const View& v : load_views(views_path)) all.push_back(record_incoherent(v));
+  for (IncoherentRays& c : all) {
+    auto wide = std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Bvh8}));
+    auto embree =
+        embree_available()
+            ? std::make_shared<Accelerator>(build_accelerator(*c.scene, AccelOptions{.kind = AccelKind::Embree}))
+            : nullptr;
+    for (const bool any_hit : {false, true}) {
+      const std::vector<Ray>* rays = any_hit ? &c.ao : &c.bounce;
+      const double mrays = double(rays->size()) * 1e-6;
+      const std::string kind = any_hit ? "/ao" : "/bounce";
+      // One ray at a time, in the order recorded (pixel by pixel), through bvh8 and Embree.
+      for (const auto& [accel_name, accel] : {std::pair{"bvh8", wide}, std::pair{"embree", embree}}) {
+        if (!accel) continue;
+        benchmark::RegisterBenchmark(("BM_Incoherent/" + c.name + "/" + accel_name + kind).c_str(),
+                                     [accel = accel, rays, any_hit, mrays](benchmark::State& st) {
+                                       size_t n = 0;
+                                       accel->visit([&](const auto& a) {
+                                         Hit h;
+                                         for (auto _ : st) {
+                                           for (const Ray& r : *rays) n += any_hit ? a.occluded(r) : a.intersect(r, h);
+                                         }
+                                       });
+                                       benchmark::DoNotOptimize(n);
+                                       st.counters["Mrays/s"] =
+                                           benchmark::Counter(mrays, benchmark::Counter::kIsIterationInvariantRate);
+                                     })
+            ->Unit(benchmark::kMillisecond);
+      }
+      // A stream: batches of 4096 rays sorted (octant, origin Morton code) and traced in that
+      // order through bvh8, the sort timed with the traversal.
+      const Aabb bounds = c.scene->bounds;
+      benchmark::RegisterBenchmark(
+          ("BM_Incoherent/" + c.name + "/bvh8-sorted" + kind).c_str(),
+          [wide, rays, any_hit, mrays, bounds](benchmark::State& st) {
+            const WideBvh& w = std::get<WideBvh>(*wide->impl);
+            constexpr size_t kBatch = 4096;
+            size_t n = 0;
+            Hit h;
+            for (auto _ : st) {
+              for (size_t b = 0; b < rays->size(); b += kBatch) {
+                for (const uint32_t i : sorted_order(*rays, b, std::min(rays->size(), b + kBatch), bounds))
+                  n += any_hit ? w.occluded((*rays)[i]) : w.intersect((*rays)[i], h);
+              }
+            }
+            benchmark::DoNotOptimize(n);
+            st.counters["Mrays/s"] = benchmark::Counter(mrays, benchmark::Counter::kIsIterationInvariantRate);
+          })
+          ->Unit(benchmark::kMillisecond);
+    }
+  }
+}
 
 void register_dynamic() {
   for (SceneCase& c : cases()) {
@@ -318,6 +448,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   tracer::register_dynamic();
+  tracer::register_incoherent();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
