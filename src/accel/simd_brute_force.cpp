@@ -20,14 +20,16 @@ namespace hn = hwy::HWY_NAMESPACE;
 bool IntersectBrute(const SimdBruteForce& bf, const Ray& ray, Hit& hit) {
   hit = Hit{};
   hit.t = ray.tfar;
-  const RayShear shear(ray);
+  const RayShear ray_shear(ray);
+  const PackRay shear(ray_shear);
   const Triangle* tris = bf.scene().triangles.data();
   for (const TrianglePack& p : bf.packs()) ClosestInPack(p, shear, tris, ray.tnear, hit);
   return finish_hit(bf.scene(), hit);
 }
 
 bool OccludedBrute(const SimdBruteForce& bf, const Ray& ray) {
-  const RayShear shear(ray);
+  const RayShear ray_shear(ray);
+  const PackRay shear(ray_shear);
   const Triangle* tris = bf.scene().triangles.data();
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
   for (const TrianglePack& p : bf.packs()) {

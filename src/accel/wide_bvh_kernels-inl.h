@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include "accel/simd_lanes-inl.h"
@@ -46,62 +47,96 @@ struct WideRay {
   }
 };
 
+using WideTag = hn::CappedTag<float, kWideWidth>;
+using WideV = hn::Vec<WideTag>;
+
+// A WideRay as the node test uses it: splatted to vectors once per query (the compiler does not
+// hoist the splats out of the traversal loop by itself), and the planes each slab is entered and
+// left by as offsets into a WideNode, so no step branches on the direction's signs.
+struct NodeRay {
+  WideV ox, oy, oz, ix, iy, iz, fx, fy, fz;
+  uint32_t near[3], far[3];  // in floats from the node's start
+  explicit NodeRay(const WideRay& r) {
+    const WideTag d;
+    ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
+    ix = hn::Set(d, r.ix), iy = hn::Set(d, r.iy), iz = hn::Set(d, r.iz);
+    fx = hn::Set(d, r.fx), fy = hn::Set(d, r.fy), fz = hn::Set(d, r.fz);
+    constexpr uint32_t lo = 0, hi = 3 * kWideWidth, axis = kWideWidth;  // lo_x, hi_x, and the next axis
+    const bool neg[3] = {r.nx, r.ny, r.nz};
+    for (uint32_t a = 0; a < 3; ++a) {
+      near[a] = (neg[a] ? hi : lo) + a * axis;
+      far[a] = (neg[a] ? lo : hi) + a * axis;
+    }
+  }
+};
+static_assert(offsetof(WideNode, hi_x) == 3 * kWideWidth * sizeof(float) &&
+              offsetof(WideNode, lo_y) == kWideWidth * sizeof(float));
+
 // Tests all children of `n` (lane_kernels-inl.h's slab test, one lane per child); writes their
 // entry distances to t_out and returns one bit per child hit.
-HWY_INLINE uint32_t TestChildren(const WideNode& n, const WideRay& r, float tnear, float tfar,
+HWY_INLINE uint32_t TestChildren(const WideNode& n, const NodeRay& r, float tnear, float tfar,
                                  float* HWY_RESTRICT t_out) {
-  const hn::CappedTag<float, kWideWidth> d;
-  using L = SimdLanes<decltype(d)>;
+  const WideTag d;
+  using L = SimdLanes<WideTag>;
   const size_t lanes = hn::Lanes(d);
-  const float* near_x = r.nx ? n.hi_x : n.lo_x;
-  const float* far_x = r.nx ? n.lo_x : n.hi_x;
-  const float* near_y = r.ny ? n.hi_y : n.lo_y;
-  const float* far_y = r.ny ? n.lo_y : n.hi_y;
-  const float* near_z = r.nz ? n.hi_z : n.lo_z;
-  const float* far_z = r.nz ? n.lo_z : n.hi_z;
-  const auto ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
-  const Lanes3<L::V> inv{hn::Set(d, r.ix), hn::Set(d, r.iy), hn::Set(d, r.iz)};
-  const Lanes3<L::V> inv_far{hn::Set(d, r.fx), hn::Set(d, r.fy), hn::Set(d, r.fz)};
+  const float* base = n.lo_x;
   const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar);
   uint32_t bits = 0;
   for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
-    const Lanes3<L::V> near{hn::Load(d, near_x + i) - ox, hn::Load(d, near_y + i) - oy, hn::Load(d, near_z + i) - oz};
-    const Lanes3<L::V> far{hn::Load(d, far_x + i) - ox, hn::Load(d, far_y + i) - oy, hn::Load(d, far_z + i) - oz};
+    const Lanes3<L::V> near{hn::Load(d, base + r.near[0] + i) - r.ox, hn::Load(d, base + r.near[1] + i) - r.oy,
+                            hn::Load(d, base + r.near[2] + i) - r.oz};
+    const Lanes3<L::V> far{hn::Load(d, base + r.far[0] + i) - r.ox, hn::Load(d, base + r.far[1] + i) - r.oy,
+                           hn::Load(d, base + r.far[2] + i) - r.oz};
     L::V t0;
-    const auto hit = slab_test<L>(near, far, inv, inv_far, vnear, vfar, t0);
+    const auto hit = slab_test<L>(near, far, {r.ix, r.iy, r.iz}, {r.fx, r.fy, r.fz}, vnear, vfar, t0);
     hn::Store(t0, d, t_out + i);
     bits |= Bits(d, hit) << i;
   }
   return bits;
 }
 
+// A RayShear as the pack test uses it: splatted once per query, the shear's axes as offsets into
+// a pack's vertex rows.
+struct PackRay {
+  const RayShear* shear;  // for the lanes the scalar test decides
+  WideV okx, oky, okz, sx, sy, sz;
+  uint32_t axis[3];  // in floats from a vertex's first row: axes kx, ky, kz
+  explicit PackRay(const RayShear& s) : shear(&s) {
+    const WideTag d;
+    const float org[3] = {s.org.x, s.org.y, s.org.z};
+    okx = hn::Set(d, org[s.kx]), oky = hn::Set(d, org[s.ky]), okz = hn::Set(d, org[s.kz]);
+    sx = hn::Set(d, s.sx), sy = hn::Set(d, s.sy), sz = hn::Set(d, s.sz);
+    axis[0] = uint32_t(s.kx) * kWideWidth;
+    axis[1] = uint32_t(s.ky) * kWideWidth;
+    axis[2] = uint32_t(s.kz) * kWideWidth;
+  }
+};
+
 // One ray against the triangles of `pack`, one lane per triangle: lane_kernels-inl.h's
 // watertight test, so each lane's t, u, v equal the scalar test's bit for bit. Lanes whose edge
 // function is exactly zero are redone by the scalar test (which decides them in double), as are
 // none in the common case. Returns the mask of lanes hit within [tnear, tfar]; their t, u, v go
 // to the arrays.
-HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, const Triangle* tris, float tnear,
+HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const PackRay& r, const Triangle* tris, float tnear,
                                   float tfar, float* HWY_RESTRICT t_out, float* HWY_RESTRICT u_out,
                                   float* HWY_RESTRICT v_out) {
-  const hn::CappedTag<float, kWideWidth> d;
-  using L = SimdLanes<decltype(d)>;
+  const WideTag d;
+  using L = SimdLanes<WideTag>;
   const size_t lanes = hn::Lanes(d);
-  const float org[3] = {s.org.x, s.org.y, s.org.z};
-  const auto okx = hn::Set(d, org[s.kx]), oky = hn::Set(d, org[s.ky]), okz = hn::Set(d, org[s.kz]);
-  const auto sx = hn::Set(d, s.sx), sy = hn::Set(d, s.sy), sz = hn::Set(d, s.sz);
   const auto vnear = hn::Set(d, tnear), vfar = hn::Set(d, tfar);
   const auto vertex = [&](int k, size_t i) {
-    return Lanes3<L::V>{hn::Load(d, p.v[k][s.kx] + i) - okx, hn::Load(d, p.v[k][s.ky] + i) - oky,
-                        hn::Load(d, p.v[k][s.kz] + i) - okz};
+    const float* row = p.v[k][0] + i;
+    return Lanes3<L::V>{hn::Load(d, row + r.axis[0]) - r.okx, hn::Load(d, row + r.axis[1]) - r.oky,
+                        hn::Load(d, row + r.axis[2]) - r.okz};
   };
   uint32_t bits = 0;
   for (size_t i = 0; i < size_t(kWideWidth); i += lanes) {
-    const ShearedTriangle<L::V> st = shear_triangle<L>(vertex(0, i), vertex(1, i), vertex(2, i), sx, sy);
+    const ShearedTriangle<L::V> st = shear_triangle<L>(vertex(0, i), vertex(1, i), vertex(2, i), r.sx, r.sy);
     const auto on_edge = on_an_edge<L>(st);
     const auto outside = passes_outside<L>(st);
     // Most packs a ray reaches it misses entirely: then skip the division and the stores.
     if (hn::AllTrue(d, hn::AndNot(on_edge, outside))) continue;
-    const TriangleLanes<L> h = triangle_hit<L>(st, outside, sz, vnear, vfar);
+    const TriangleLanes<L> h = triangle_hit<L>(st, outside, r.sz, vnear, vfar);
     hn::Store(h.t, d, t_out + i);
     hn::Store(h.u, d, u_out + i);
     hn::Store(h.v, d, v_out + i);
@@ -112,7 +147,7 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
       const uint32_t id = p.id[i + size_t(k)];
       TriangleHit th;
       hit &= ~(1u << k);
-      if (id != kInvalidIndex && intersect_triangle(s, tris[id], tnear, tfar, th)) {
+      if (id != kInvalidIndex && intersect_triangle(*r.shear, tris[id], tnear, tfar, th)) {
         hit |= 1u << k;
         t_out[i + size_t(k)] = th.t;
         u_out[i + size_t(k)] = th.u;
@@ -127,7 +162,7 @@ HWY_INLINE uint32_t IntersectPack(const TrianglePack& p, const RayShear& s, cons
 // Updates `hit` with the closest lane of `pack` (ties to the lower scene index, as everywhere).
 // The nearest of several hit lanes is found by a SIMD minimum over the lanes, not a loop; only
 // lanes tied exactly at that minimum (rare) are compared one by one for the lower index.
-HWY_INLINE void ClosestInPack(const TrianglePack& p, const RayShear& shear, const Triangle* tris, float tnear,
+HWY_INLINE void ClosestInPack(const TrianglePack& p, const PackRay& shear, const Triangle* tris, float tnear,
                               Hit& hit) {
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
   const uint32_t bits = IntersectPack(p, shear, tris, tnear, hit.t, tt, uu, vv);
@@ -221,12 +256,14 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
   int sp = 0;
   HWY_ALIGN float t[kWideWidth];
   HWY_ALIGN float tt[kWideWidth], uu[kWideWidth], vv[kWideWidth];
+  const NodeRay node_ray(wr);
+  const PackRay pack_ray(shear);
   StackEntry cur = start;
   for (;;) {
     if (cur.count == 0) {
       // Any hit ends the query, so the children need no order: push them as found.
       const WideNode& n = nodes[cur.child];
-      uint32_t bits = TestChildren(n, wr, tnear, tfar, t);
+      uint32_t bits = TestChildren(n, node_ray, tnear, tfar, t);
       if (bits) {
         int c = __builtin_ctz(bits);
         for (bits &= bits - 1; bits; bits &= bits - 1) {
@@ -236,7 +273,7 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
         cur = {n.child[c], n.count[c], 0.0f};
         continue;
       }
-    } else if (IntersectPack(packs[cur.child], shear, tris, tnear, tfar, tt, uu, vv)) {
+    } else if (IntersectPack(packs[cur.child], pack_ray, tris, tnear, tfar, tt, uu, vv)) {
       return true;
     }
     if (sp == 0) return false;

@@ -17,8 +17,9 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   hit.t = ray.tfar;
   const auto& nodes = bvh.nodes();
   if (nodes.empty()) return false;
-  const WideRay wr(ray);
-  const RayShear shear(ray);
+  const NodeRay wr{WideRay(ray)};
+  const RayShear ray_shear(ray);
+  const PackRay shear(ray_shear);
   const Triangle* tris = bvh.scene().triangles.data();
   const TrianglePack* packs = bvh.packs().data();
   StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
