@@ -74,6 +74,9 @@ build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/(Sphere|Wa
 # (single builds on this shared VM vary by several milliseconds; compare minima and medians).
 build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/Bunny/(sah/(seq|tasks)|embree)' \
   --benchmark_repetitions=12 --benchmark_format=console 2>/dev/null | tee "$O/build-bunny.txt"
+# Incoherent rays on the views, traversal only: bounces and AO rays, single and sorted (section 8).
+build/release/bench/tracer_microbench --benchmark_filter='BM_Incoherent/' --benchmark_repetitions=3 \
+  --benchmark_report_aggregates_only=true 2>/dev/null | grep _median | tee "$O/incoherent.txt"
 # 5. The path tracer: incoherent rays beside Embree, and time to a noise level.
 scripts/benchmarks-path.sh
 # 6. tracer-mpi: the same render as 1 rank x 2 threads and 2 ranks x 1 thread.
