@@ -506,8 +506,10 @@ int run_bench(const BenchArgs& a) {
       return fmt(s.total_ms / c.total_ms, 1) + " / " + fmt(study_speedup, 1);
     });
   }
-  for (const auto& [reference, title] : {std::pair<std::string, std::string>{"embree", "Embree's single rays"},
-                                         {"embree-packets", "Embree's packet API"}}) {
+  for (const auto& [reference_name, title] : {std::pair<std::string, std::string>{"embree", "Embree's single rays"},
+                                              {"embree-packets", "Embree's packet API"}}) {
+    // A plain reference: clang 14 cannot capture a structured binding in a lambda.
+    const std::string& reference = reference_name;
     const bool present =
         std::any_of(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == reference; });
     if (!present) continue;
