@@ -159,16 +159,18 @@ class BvhBuilder {
   // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
   // triangle index of every leaf slot. Each subtree's place follows from its size alone, so the
   // tasks build flattens its large subtrees in parallel into the same layout.
-  // `pair_parent` receives each sibling pair's parent, `leaf_of` each scene triangle's leaf.
-  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent,
-               std::vector<uint32_t>& leaf_of) {
+  // `pair_parent` (if not null) receives each sibling pair's parent, `leaf_of` (if not null,
+  // sized to the scene) each scene triangle's leaf.
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>* pair_parent,
+               std::vector<uint32_t>* leaf_of) {
     ids.resize(count_);
     // subtree_size() also fills in the sizes the queue build left unknown at the top.
     out.resize(count_ == 0 ? 0 : subtree_size(0) + 1);  // + the padding node
-    pair_parent.assign((out.size() + 1) / 2, 0);
+    if (pair_parent) pair_parent->assign((out.size() + 1) / 2, 0);
     if (count_ == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
-    const Output o{out.data(), ids.data(), pair_parent.data(), leaf_of.data()};
+    const Output o{out.data(), ids.data(), pair_parent ? pair_parent->data() : nullptr,
+                   leaf_of ? leaf_of->data() : nullptr};
     place(o, 0, 0, 2, options_.mode == BuildMode::Tasks);
   }
 
@@ -297,13 +299,13 @@ class BvhBuilder {
       const PrimRef* refs = buffers_[n.buffer].get();
       for (uint32_t i = n.begin; i < n.end; ++i) {
         out.ids[i] = refs[i].id();
-        out.leaf_of[refs[i].id()] = flat;
+        if (out.leaf_of) out.leaf_of[refs[i].id()] = flat;
       }
       return;
     }
     f.index = next;
     f.count = 0;
-    out.pair_parent[next / 2] = flat;
+    if (out.pair_parent) out.pair_parent[next / 2] = flat;
     const uint32_t left = n.left, right_next = next + 2 + (nodes_[left].subtree - 1);
     const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
     const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
@@ -644,12 +646,39 @@ class BvhBuilder {
 
 }  // namespace
 
+namespace {
+
+// Runs `construct` where the build's parallel pieces run: a oneTBB arena of the build's thread
+// count for the tasks build (setup included), the calling thread otherwise.
+template <class F>
+void in_build_arena(const BvhBuildOptions& options, F&& construct) {
+  if (options.mode == BuildMode::Tasks) {
+    tbb::task_arena arena(resolve_thread_count(options.threads));
+    arena.execute(construct);
+  } else {
+    construct();
+  }
+  throw_if_cancelled(options.cancel);
+}
+
+}  // namespace
+
+BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options) {
+  BvhTopology t;
+  in_build_arena(options, [&] {
+    BvhBuilder builder(scene, options);
+    builder.build();
+    builder.flatten(t.nodes, t.ids, nullptr, nullptr);
+  });
+  return t;
+}
+
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), options_(options) {
-  const auto construct = [&] {
+  in_build_arena(options, [&] {
     BvhBuilder builder(scene, options);
     builder.build();
     leaf_of_.assign(scene.size(), kInvalidIndex);
-    builder.flatten(nodes_, ids_, pair_parent_, leaf_of_);
+    builder.flatten(nodes_, ids_, &pair_parent_, &leaf_of_);
     tris_.resize(ids_.size());
     const auto copy = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];
@@ -662,15 +691,7 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
     } else {
       copy(0, ids_.size());
     }
-  };
-  if (options.mode == BuildMode::Tasks) {
-    // Every parallel piece of the tasks build, setup included, runs on this many threads.
-    tbb::task_arena arena(resolve_thread_count(options.threads));
-    arena.execute(construct);
-  } else {
-    construct();
-  }
-  throw_if_cancelled(options.cancel);
+  });
 }
 
 }  // namespace tracer

@@ -54,16 +54,13 @@ bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const {
 bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
 
 SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
-  std::vector<Triangle> tris;
   std::vector<uint32_t> ids;
   for (uint32_t i = 0; i < scene.size(); ++i) {
-    if (scene.triangles[i].degenerate()) continue;
-    tris.push_back(scene.triangles[i]);
-    ids.push_back(i);
+    if (!scene.triangles[i].degenerate()) ids.push_back(i);
   }
-  for (uint32_t first = 0; first < tris.size(); first += kWideWidth) {
+  for (uint32_t first = 0; first < ids.size(); first += kWideWidth) {
     packs_.push_back(
-        make_triangle_pack(tris, ids, first, std::min<uint32_t>(kWideWidth, uint32_t(tris.size()) - first)));
+        make_triangle_pack(scene.triangles, ids, first, std::min<uint32_t>(kWideWidth, uint32_t(ids.size()) - first)));
   }
 }
 

@@ -106,8 +106,8 @@ class SimdBruteForce {
   std::vector<TrianglePack> packs_;
 };
 
-// Packs triangles[first, first+count) (count <= 8) into one TrianglePack; lane k's id is
-// ids[first + k], padding lanes are NaN.
+// Packs the scene triangles ids[first, first+count) (count <= 8) into one TrianglePack: lane k
+// holds triangles[ids[first + k]] and that id; padding lanes are NaN.
 TrianglePack make_triangle_pack(std::span<const Triangle> triangles, std::span<const uint32_t> ids, uint32_t first,
                                 uint32_t count);
 

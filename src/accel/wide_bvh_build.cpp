@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
 #include "accel/wide_bvh.hpp"
+#include "parallel/tbb_sync.hpp"
+#include "parallel/thread_count.hpp"
 
 namespace tracer {
 
@@ -13,11 +17,11 @@ namespace {
 // index of the wide node made for `root`.
 class Collapser {
  public:
-  Collapser(const Bvh& bin, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
-      : bin_(bin), out_(out), packs_(packs), first_(bin.nodes().size()), count_(bin.nodes().size()) {
+  Collapser(const BvhTopology& bin, const Scene& scene, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
+      : bin_(bin), scene_(scene), out_(out), packs_(packs), first_(bin.nodes.size()), count_(bin.nodes.size()) {
     // Each binary subtree's triangles are one contiguous run (the builder lays leaves out in
     // depth-first order); record it, children before parents (children have larger indices).
-    const auto& nodes = bin.nodes();
+    const auto& nodes = bin.nodes;
     for (size_t i = nodes.size(); i-- > 0;) {
       if (i == 1) continue;  // padding
       const BvhNode& n = nodes[i];
@@ -30,12 +34,12 @@ class Collapser {
     // Open the largest inner node until eight children (or only leaves) remain: keeps the
     // children's total surface area, and so the expected cost, as low as greedy can.
     std::vector<uint32_t> kids{root};
-    if (!packable(root)) kids = {bin_.nodes()[root].index, bin_.nodes()[root].index + 1};
+    if (!packable(root)) kids = {bin_.nodes[root].index, bin_.nodes[root].index + 1};
     while (kids.size() < size_t(kWideWidth)) {
       int best = -1;
       float best_area = -1.0f;
       for (size_t i = 0; i < kids.size(); ++i) {
-        const BvhNode& n = bin_.nodes()[kids[i]];
+        const BvhNode& n = bin_.nodes[kids[i]];
         const float area = Aabb{n.lo, n.hi}.half_area();
         if (!packable(kids[i]) && area > best_area) {
           best = int(i);
@@ -43,7 +47,7 @@ class Collapser {
         }
       }
       if (best < 0) break;
-      const BvhNode& n = bin_.nodes()[kids[size_t(best)]];
+      const BvhNode& n = bin_.nodes[kids[size_t(best)]];
       kids[size_t(best)] = n.index;
       kids.insert(kids.begin() + best + 1, n.index + 1);
     }
@@ -59,7 +63,7 @@ class Collapser {
       }
     }
     for (size_t i = 0; i < kids.size(); ++i) {
-      const BvhNode& n = bin_.nodes()[kids[i]];
+      const BvhNode& n = bin_.nodes[kids[i]];
       uint32_t child = 0, count = 0;
       if (packable(kids[i])) {
         count = count_[kids[i]];
@@ -85,15 +89,37 @@ class Collapser {
   // costs about what one more level of boxes would, and saves that level's loads.
   bool packable(uint32_t node) const { return count_[node] <= uint32_t(kWideWidth); }
 
+  // Leaves are numbered here and filled afterwards, in parallel (fill_packs): filling gathers
+  // each triangle from the scene, a cache miss per triangle on large scenes.
   uint32_t make_pack(uint32_t first, uint32_t count) {
-    packs_.push_back(make_triangle_pack(bin_.triangles(), bin_.triangle_ids(), first, count));
-    return static_cast<uint32_t>(packs_.size() - 1);
+    pack_runs_.push_back({first, count});
+    return static_cast<uint32_t>(pack_runs_.size() - 1);
   }
 
-  const Bvh& bin_;
+ public:
+  void fill_packs(bool parallel) {
+    packs_.resize(pack_runs_.size());
+    const auto fill = [&](size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k)
+        packs_[k] = make_triangle_pack(scene_.triangles, bin_.ids, pack_runs_[k].first, pack_runs_[k].count);
+    };
+    constexpr size_t kBlock = 1024;
+    const auto blocks = uint32_t((pack_runs_.size() + kBlock - 1) / kBlock);
+    if (!parallel || blocks < 2) return fill(0, pack_runs_.size());
+    TbbSync().for_each(
+        blocks, [&](uint32_t b) { fill(size_t(b) * kBlock, std::min(pack_runs_.size(), size_t(b + 1) * kBlock)); });
+  }
+
+ private:
+  const BvhTopology& bin_;
+  const Scene& scene_;
   std::vector<WideNode>& out_;
   std::vector<TrianglePack>& packs_;
   std::vector<uint32_t> first_, count_;  // per binary node: its subtree's triangle run
+  struct Run {
+    uint32_t first, count;
+  };
+  std::vector<Run> pack_runs_;  // per pack: its triangles' run in bin_.ids
 };
 
 }  // namespace
@@ -101,11 +127,18 @@ class Collapser {
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_(&scene) {
   BvhBuildOptions options = options_in;
   options.max_leaf = std::min(options.max_leaf, kWideWidth);
-  const Bvh binary(scene, options);
-  if (binary.nodes().empty()) return;
-  nodes_.reserve(binary.nodes().size() / 4 + 1);
-  Collapser(binary, nodes_, packs_).collapse(0);
-  bounds_ = Aabb{binary.nodes()[0].lo, binary.nodes()[0].hi};
+  const BvhTopology binary = build_bvh_topology(scene, options);
+  if (binary.nodes.empty()) return;
+  nodes_.reserve(binary.nodes.size() / 4 + 1);
+  Collapser collapser(binary, scene, nodes_, packs_);
+  collapser.collapse(0);
+  if (options.mode == BuildMode::Tasks) {
+    tbb::task_arena arena(resolve_thread_count(options.threads));
+    arena.execute([&] { collapser.fill_packs(true); });
+  } else {
+    collapser.fill_packs(false);
+  }
+  bounds_ = Aabb{binary.nodes[0].lo, binary.nodes[0].hi};
   // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
   node_place_.assign(nodes_.size(), kInvalidIndex);
   leaf_place_.assign(scene.size(), kInvalidIndex);
