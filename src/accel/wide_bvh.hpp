@@ -41,6 +41,9 @@ struct alignas(64) TrianglePack {
   uint32_t id[kWideWidth];
 };
 
+// Packs, 64-byte aligned, left uninitialised by resize() (the build fills them in parallel).
+using PackArray = std::vector<TrianglePack, CacheAlignedAllocator<TrianglePack>>;
+
 class WideBvh {
  public:
   // Builds the binary SAH tree with `options` (leaves of up to eight triangles: one pack), then
@@ -59,7 +62,7 @@ class WideBvh {
   uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
-  const std::vector<TrianglePack>& packs() const { return packs_; }
+  const PackArray& packs() const { return packs_; }
   // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kInvalidIndex.
   const std::vector<uint32_t>& node_places() const { return node_place_; }
   // The node and slot of the leaf holding each scene triangle (kInvalidIndex: degenerate, in no leaf).
@@ -85,7 +88,7 @@ class WideBvh {
  private:
   const Scene* scene_;
   std::vector<WideNode> nodes_;
-  std::vector<TrianglePack> packs_;
+  PackArray packs_;
   std::vector<uint32_t> node_place_, leaf_place_;
   Aabb bounds_;
 };

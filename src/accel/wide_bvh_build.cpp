@@ -17,7 +17,7 @@ namespace {
 // index of the wide node made for `root`.
 class Collapser {
  public:
-  Collapser(const BvhTopology& bin, const Scene& scene, std::vector<WideNode>& out, std::vector<TrianglePack>& packs)
+  Collapser(const BvhTopology& bin, const Scene& scene, std::vector<WideNode>& out, PackArray& packs)
       : bin_(bin), scene_(scene), out_(out), packs_(packs), first_(bin.nodes.size()), count_(bin.nodes.size()) {
     // Each binary subtree's triangles are one contiguous run (the builder lays leaves out in
     // depth-first order); record it, children before parents (children have larger indices).
@@ -114,7 +114,7 @@ class Collapser {
   const BvhTopology& bin_;
   const Scene& scene_;
   std::vector<WideNode>& out_;
-  std::vector<TrianglePack>& packs_;
+  PackArray& packs_;
   std::vector<uint32_t> first_, count_;  // per binary node: its subtree's triangle run
   struct Run {
     uint32_t first, count;
