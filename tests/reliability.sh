@@ -14,6 +14,27 @@ trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
 # Written before ok.obj: files newer than ok.obj are what a case left behind, and are removed.
+printf 'mtllib dark.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 100 100 100\nv 101 100 100\nv 100 101 100\nf 1 2 3\nusemtl lamp\nf 4 6 5\n' > dark.obj
+printf 'newmtl lamp\nKe 10 10 10\n' > dark.mtl
+printf 'mtllib grey.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n' > grey.obj
+printf 'newmtl  Lamp\nKd 0.5\nKe 1\n' > grey.mtl
+printf 'mtllib kdnan.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > kdnan.obj
+printf 'newmtl a\nKd nan 0 0\n' > kdnan.mtl
+printf 'v -1e13 -1e13 0\nv 1e13 -1e13 0\nv 0 1e13 0\nf 1 2 3\n' > huge.obj
+printf 'mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > zero.obj
+ln -s /dev/zero zero.mtl
+printf 'mtllib never.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > fifomtl.obj
+mkfifo never.mtl
+printf 'mtllib bomb.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > bomb.obj
+printf 'newmtl a\nmap_Kd bomb.png\n' > bomb.mtl
+# A PNG header claiming 16384 x 16384 texels (IHDR and its CRC), and nothing more.
+printf '\211PNG\r\n\032\n\000\000\000\rIHDR\000\000\100\000\000\000\100\000\010\002\000\000\000\046\252\207\323' > bomb.png
+mkdir viewsdir
+printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > viewsdir/tri.obj
+printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\ttri.obj\t0,0,3\t0,0\n' > viewsdir/views.tsv
+printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\n' > tri-views.tsv
+mkfifo out-fifo.png
+ln -s target.png link.png
 printf 'mtllib tex.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 2/2 3/3\n' > tex.obj
 printf 'newmtl a\nmap_Kd Missing.PNG\nnewmtl b\nmap_Kd missing.png\n' > tex.mtl
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > ok.obj
@@ -36,6 +57,7 @@ cp ok.obj locked.obj
 chmod 000 locked.obj
 mkfifo fifo.obj
 mkfifo silent.obj
+mkfifo nowriter.obj
 
 inputs=$(ls)
 as_user=()
@@ -69,7 +91,7 @@ cases=(
   "one allowed core (taskset -c 0), default threads|taskset -c 0 tracer render -q --width 32 --height 32 -o t.png|0"
   "--threads 64 on a smaller machine|tracer render --threads 64 -q --width 32 --height 32 -o t.png|0"
   "--spp 0|tracer render --integrator path --spp 0 -q|2"
-  "--spp with --integrator ao|tracer render --integrator ao --spp 16 -q|2"
+  "--spp with --integrator ao (anti-aliasing)|tracer render --integrator ao --spp 4 -q --width 8 --height 8 -o a.png|0"
   "--env with a negative component|tracer render --integrator path --env 1,-1,1 -q|2"
   "--checkpoint 0|tracer render --integrator path --checkpoint 0 -q|2"
   "two materials name a missing texture|tracer render tex.obj --width 32 --height 32 -o t.png|0"
@@ -85,6 +107,29 @@ cases=(
   "Ctrl-C while the scene is still arriving, --save-partial|(sleep 5 > silent.obj &) ; timeout --foreground --preserve-status -s INT 1 tracer render silent.obj -q --save-partial -o out.png|130"
   "kill -9 while rendering|timeout --foreground --preserve-status -s KILL 1 tracer $SLOW|137"
   "Ctrl-C during a path render (after its first pass)|timeout --foreground --preserve-status -s INT 2 tracer $PATH_RENDER|130"
+  "Ctrl-C with --sched async (rows already running stop too)|timeout --foreground --preserve-status -s INT 1 tracer $SLOW --sched async|130"
+  "Ctrl-C with one 4096-pixel tile|timeout --foreground --preserve-status -s INT 1 tracer $SLOW --tile 4096|130"
+  "SIGINT while opening a FIFO scene with no writer|timeout --foreground --preserve-status -s INT 1 tracer render nowriter.obj -q|130"
+  "SIGTERM while opening a FIFO scene with no writer|timeout --foreground --preserve-status -s TERM 1 tracer render nowriter.obj -q|143"
+  "SIGHUP while opening a FIFO scene with no writer|timeout --foreground --preserve-status -s HUP 1 tracer render nowriter.obj -q|129"
+  "Ctrl-C while an mtllib FIFO has no writer|timeout --foreground --preserve-status -s INT 1 tracer render fifomtl.obj -q|130"
+  "mtllib is /dev/zero|tracer render zero.obj -q|1"
+  "--stats-json into a device node|tracer render ok.obj -q --width 8 --height 8 -o o.png --stats-json /dev/null|0"
+  "--stats-json into a full device|tracer render ok.obj -q --width 8 --height 8 -o o.png --stats-json /dev/full|1"
+  "-o into a FIFO|(cat out-fifo.png > /dev/null &) ; tracer render ok.obj -q --width 8 --height 8 -o out-fifo.png|0"
+  "-o is a symbolic link: its target is written|tracer render ok.obj -q --width 8 --height 8 -o link.png|0"
+  "--stats-json is the scene's MTL|tracer render tex.obj -q --stats-json tex.mtl|2"
+  "bench --plot is the scene|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes ok.obj --plot ok.obj|2"
+  "--fov 1e-30 with Embree|tracer render --fov 1e-30 --accel embree -q|2"
+  "a triangle beyond +-1e12|tracer render huge.obj -q --integrator ao --ao 0|1"
+  "Kd nan in the MTL|tracer render kdnan.obj -q|1"
+  "Kd 0.5 (one value: grey), newmtl with two spaces|tracer render grey.obj -q --width 8 --height 8 -o g.png|0"
+  "the only emitter out of view|tracer render dark.obj -q --width 8 --height 8 --spp 2 --eye 0,0,3 --look 0,0,0 -o d.png|0"
+  "an empty scene name|tracer render '' -q|2"
+  "an unknown --view|tracer render --view unknown --views tri-views.tsv -q|2"
+  "--integrator whitted --spp 4|tracer render --integrator whitted --spp 4 -q --width 8 --height 8 -o w.png|0"
+  "a texture claiming 16384x16384 texels|tracer render bomb.obj --width 8 --height 8 -o b.png|0"
+  "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
 )
 
 table=$'| case | command | exit | first line on stderr | left in the directory |\n|---|---|---:|---|---|\n'

@@ -35,9 +35,14 @@ inline void throw_if_cancelled(CancelFlag flag) {
   if (is_cancelled(flag)) throw Cancelled();
 }
 
-// The largest coordinate magnitude a scene, camera or light may have. Beyond it the products in
-// the ray tests (edge cross products, squared distances) overflow float, and Embree rejects
-// such rays outright (its FLT_LARGE is 1.844e18).
-inline constexpr float kMaxCoordinate = 1e18f;
+// The largest coordinate magnitude a scene, camera or light may have, and how it reads in
+// messages. The watertight triangle test's distance is a product of three coordinate
+// differences (an edge function, about d^2, times a distance d): past about 7e12 it overflows
+// float and the triangle vanishes, so 1e12 leaves room for a camera a few times as far out.
+inline constexpr float kMaxCoordinate = 1e12f;
+inline constexpr const char* kMaxCoordinateText = "1e12";
+// How far from the origin an automatically framed camera may stand (a very narrow --fov backs
+// it off): rays from there still reach every vertex without overflow.
+inline constexpr float kMaxCameraDistance = 4e12f;
 
 }  // namespace tracer

@@ -22,6 +22,7 @@
 #include "accel/accelerator.hpp"
 #include "base/errors.hpp"
 #include "cli/parse.hpp"
+#include "cli/render_args.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
@@ -174,7 +175,7 @@ std::vector<SceneEntry> resolve_scenes(const BenchArgs& a) {
     } else if (item == "builtin") {
       out.push_back({"builtin", "", std::nullopt});
     } else if (item.find('/') == std::string::npos && item.find('.') == std::string::npos) {
-      add_view(find_view(all_views(), item, views_path));
+      add_view(find_view(all_views(), item, views_path, "--scenes"));
     } else {
       std::string name = std::filesystem::path(item).stem().string();
       if (name.rfind("CornellBox-", 0) == 0) name = name.substr(11);  // the study's scene names
@@ -361,8 +362,17 @@ int run_bench(const BenchArgs& a) {
   check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, true);
   const std::vector<Variant> variants = resolve_variants(a.variants);
   const std::vector<SceneEntry> scenes = resolve_scenes(a);
-  for (const std::string* out : {&a.json, &a.plot, &a.markdown}) {
-    if (!out->empty()) check_writable(*out);
+  const std::pair<const std::string*, const char*> outputs[] = {
+      {&a.json, "--json"}, {&a.plot, "--plot"}, {&a.markdown, "--markdown"}};
+  // Up front against the scene files (loaded later, one at a time) and the views file (read).
+  for (const auto& [out, flag] : outputs) {
+    if (out->empty()) continue;
+    check_output(*out, flag);
+    for (const SceneEntry& se : scenes) {
+      if (!se.path.empty() && same_file(*out, se.path)) {
+        throw UsageError(std::string(flag) + ": '" + *out + "' is an input of this run (" + se.path + ")");
+      }
+    }
   }
 
   std::map<std::pair<std::string, std::string>, Cell> cells;
@@ -521,6 +531,11 @@ int run_bench(const BenchArgs& a) {
     });
   }
   std::cout << md.str();
+  // Every output once more against every file the run read (MTL files, textures), before any
+  // of them is written.
+  for (const auto& [out, flag] : outputs) {
+    if (!out->empty()) check_output(*out, flag);
+  }
   if (!a.markdown.empty()) write_file_atomic(a.markdown, md.str());
   if (!a.json.empty()) {
     nlohmann::json j = {{"size", {width, height}},

@@ -42,6 +42,7 @@ int cmd_render(const RenderArgs& args) {
   const auto t_load = std::chrono::steady_clock::now();
   const Scene scene = load_scene(args.scene, args.quiet, cancel);
   const double load_ms = ms_since(t_load);
+  check_outputs_against_inputs(args);
   const CameraSpec camera = camera_for(scene, args);
   std::string lighting_note;
   const RenderSettings settings = settings_for(args, scene, lighting_note);
@@ -58,6 +59,7 @@ int cmd_render(const RenderArgs& args) {
   const uint64_t work =
       uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
   ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
+  bool warned_black = false;
   // Each frame of --frames N: the camera orbits the look point; one output file per frame.
   for (int frame = 0; frame < args.frames; ++frame) {
     const std::string output = frame_output(args.output, frame, args.frames);
@@ -91,6 +93,10 @@ int cmd_render(const RenderArgs& args) {
       return exit_code_for_stop();
     }
     write_image();
+    if (!warned_black && looks_black(fb, settings.exposure)) {
+      std::cerr << "tracer: warning: " << output << ": " << black_image_warning(settings, scene) << "\n";
+      warned_black = true;
+    }
     if (stop_signal() != 0) {  // arrived during the write, which is never torn
       progress.stop();
       std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << output

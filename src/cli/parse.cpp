@@ -9,37 +9,36 @@
 namespace tracer::cli {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text) {
-  float v[3];
+  double v[3];
   int n = 0;
   size_t pos = 0;
-  bool ok = true;
-  while (ok) {
+  for (;;) {
     const size_t comma = text.find(',', pos);
     const std::string part = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    if (n == 3) {
-      ok = false;
-      break;
-    }
     const char* b = part.data();
     const char* e = b + part.size();
-    const auto [ptr, ec] = std::from_chars(b, e, v[n]);
-    if (part.empty() || ec != std::errc{} || ptr != e || !std::isfinite(v[n])) {
-      ok = false;
-      break;
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(b, e, value);
+    if (n == 3 || part.empty() || ptr != e || (ec != std::errc{} && ec != std::errc::result_out_of_range)) {
+      throw UsageError(flag + ": expected three numbers x,y,z, got '" + text + "'");
     }
-    ++n;
+    if (ec == std::errc::result_out_of_range || !std::isfinite(value) || std::fabs(value) > 3.4e38) {
+      throw UsageError(flag + ": '" + part + "' is out of range (not a finite float) in '" + text + "'");
+    }
+    v[n++] = value;
     if (comma == std::string::npos) break;
     pos = comma + 1;
   }
-  if (!ok || n != 3) throw UsageError(flag + ": expected three finite numbers x,y,z, got '" + text + "'");
-  return {v[0], v[1], v[2]};
+  if (n != 3) throw UsageError(flag + ": expected three numbers x,y,z, got '" + text + "'");
+  return {float(v[0]), float(v[1]), float(v[2])};
 }
 
 Vec3 parse_point(const std::string& flag, const std::string& text) {
   const Vec3 p = parse_vec3(flag, text);
   for (const float c : {p.x, p.y, p.z}) {
-    if (std::fabs(c) > kMaxCoordinate)
-      throw UsageError(flag + ": coordinates must lie within +-1e18, got '" + text + "'");
+    if (std::fabs(c) > kMaxCoordinate) {
+      throw UsageError(flag + ": coordinates must lie within +-" + kMaxCoordinateText + ", got '" + text + "'");
+    }
   }
   return p;
 }

@@ -20,7 +20,9 @@ namespace tracer::cli {
 namespace fs = std::filesystem;
 
 void add_scene_options(CLI::App& app, SceneArgs& a) {
-  app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)");
+  app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)")
+      ->check(CLI::Validator(
+          [](const std::string& s) { return s.empty() ? std::string("an empty file name") : std::string(); }, "FILE"));
   app.add_option("--view", a.view, "render a named view: its scene, camera and light (e.g. sponza, cornell-water)");
   app.add_option("--views", a.views, "the views file for --view (default ../shared/scenes/views.tsv)");
   app.add_option("--builtin-spheres", a.builtin_spheres,
@@ -28,6 +30,11 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
   app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
   app.add_flag("--no-scene-lights", a.no_scene_lights, "drop the scene's emissive lights, keep only --light ones");
   app.add_option("--light-intensity", a.light_intensity, "point light intensity (default: (scene diagonal / 2)^2)");
+  app.add_option("--max-input-mib", a.max_input_mib, "largest OBJ file read, in MiB (1-1048576)")
+      ->capture_default_str();
+  app.add_option("--max-texture-mib", a.max_texture_mib,
+                 "memory all the scene's textures may take, in MiB (1-1048576); past it a texture is not used")
+      ->capture_default_str();
 }
 
 void add_render_options(CLI::App& app, RenderArgs& a) {
@@ -48,7 +55,8 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                  "whitted: reflections and refractions followed; path: bounces per path (0-64)")
       ->capture_default_str();
   app.add_option("--spp", a.spp,
-                 "path: samples per pixel (1-1048576, default " + std::to_string(kDefaultPathSpp) + ")");
+                 "samples per pixel (1-1048576; default " + std::to_string(kDefaultPathSpp) +
+                     " for path, 1 through the pixel centre for ao and whitted)");
   app.add_option("--env", a.env,
                  "path: radiance r,g,b of a uniform environment (default black; white when the scene has no light)");
   app.add_option("--light-sampling", a.light_sampling,
@@ -115,7 +123,7 @@ void validate(const RenderArgs& a) {
     }
   }
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
-  if (a.fov) check_range_real("--fov", *a.fov, 0.0, 179.0, true);
+  if (a.fov) check_range_real("--fov", *a.fov, 1e-3, 179.0);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
   check_range_real("--exposure", s.exposure, 0.0, 1e6, true);
   check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);
@@ -142,7 +150,6 @@ void validate(const RenderArgs& a) {
   exr_pixel_for(a);
 }
 
-// Two paths name the same file: the same inode if both exist, else the same absolute path.
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
   if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
@@ -161,6 +168,11 @@ void check_outputs(const RenderArgs& a) {
   }
   if (same_file(a.stats_json, a.output)) throw UsageError("--stats-json: '" + a.stats_json + "' is also the -o image");
   check_writable(a.stats_json);
+}
+
+void check_outputs_against_inputs(const RenderArgs& a) {
+  for (int frame = 0; frame < a.frames; ++frame) check_output(frame_output(a.output, frame, a.frames), "-o");
+  if (!a.stats_json.empty()) check_output(a.stats_json, "--stats-json");
 }
 
 namespace {
@@ -183,24 +195,32 @@ void add_lights(Scene& scene, const SceneArgs& a) {
 }  // namespace
 
 Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
+  check_range("--max-input-mib", (long long)a.max_input_mib, 1, 1 << 20);
+  check_range("--max-texture-mib", (long long)a.max_texture_mib, 1, 1 << 20);
+  LoadLimits limits;
+  limits.max_obj_bytes = a.max_input_mib << 20;
+  limits.textures.max_total_bytes = a.max_texture_mib << 20;
   const WarningSink silent = [](const std::string&) {};
   const WarningSink warn = quiet ? silent : WarningSink{};
   if (!a.view.empty()) {
     if (!a.scene.empty()) throw UsageError("--view: the view names its scene; give either a scene or --view");
     const std::string path = a.views.empty() ? default_views_path() : a.views;
     const View view = find_view(load_views(path), a.view, path);
-    Scene scene = load_obj(view.obj, warn, cancel);
+    Scene scene = load_obj(view.obj, warn, cancel, limits);
     apply_view_light(scene, view);
     scene.camera = view.camera;
     add_lights(scene, a);
     return scene;
   }
-  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel);
+  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits);
   // A scene with no light of its own (Sponza, Sibenik, the Bunny) that a views.tsv beside it
   // knows: its view's camera, and its light unless --light gives one, so a plain render shows it
   // as the views mean it (from inside, lit) rather than framed from outside in the dark.
   if (!a.scene.empty() && a.scene != "-" && scene.lights.empty()) {
-    if (const std::optional<View> view = view_of_scene_file(a.scene)) {
+    std::string problem;
+    const std::optional<View> view = view_of_scene_file(a.scene, &problem);
+    if (!problem.empty() && !quiet) std::cerr << "tracer: warning: " << problem << " (its views are not used)\n";
+    if (view) {
       if (a.lights.empty()) apply_view_light(scene, *view);
       scene.camera = view->camera;
       if (!quiet) {
@@ -232,6 +252,12 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
     const Vec3 up = parse_vec3("--up", a.up);
     spec.up = up * (1.0f / std::max({std::fabs(up.x), std::fabs(up.y), std::fabs(up.z)}));
   }
+  // A narrow --fov backs the framed camera off; past kMaxCameraDistance its rays could not reach
+  // the scene without overflow (and Embree refuses such rays).
+  if (std::max({std::fabs(spec.eye.x), std::fabs(spec.eye.y), std::fabs(spec.eye.z)}) > kMaxCameraDistance) {
+    throw UsageError("--fov: " + std::to_string(spec.fov_degrees) +
+                     " degrees frames this scene from too far away (beyond 4e12); widen it or give --eye");
+  }
   const Vec3 forward = spec.look - spec.eye;
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
@@ -253,8 +279,10 @@ CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double or
 std::string frame_output(const std::string& output, int frame, int frames) {
   if (frames <= 1) return output;
   const fs::path p(output);
-  char number[16];
-  std::snprintf(number, sizeof number, "-%04d", frame);
+  // At least four digits, and as many as the last frame needs, so names sort in frame order.
+  const int digits = std::max(4, int(std::to_string(frames - 1).size()));
+  char number[24];
+  std::snprintf(number, sizeof number, "-%0*d", digits, frame);
   return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
 }
 
@@ -265,11 +293,11 @@ RenderSettings settings_for(const RenderArgs& a) {
   s.light_sampling =
       parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
   const bool path = s.integrator == Integrator::Path;
-  for (const auto& [flag, given] :
-       {std::pair{"--spp", a.spp.has_value()}, {"--env", !a.env.empty()}, {"--checkpoint", a.checkpoint.has_value()}}) {
+  for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--checkpoint", a.checkpoint.has_value()}}) {
     if (given && !path) throw UsageError(std::string(flag) + ": only for --integrator path");
   }
-  s.spp = path ? a.spp.value_or(kDefaultPathSpp) : 1;
+  // Every integrator anti-aliases with --spp; ao and whitted take one centred sample by default.
+  s.spp = a.spp.value_or(path ? kDefaultPathSpp : 1);
   if (!a.env.empty()) s.environment = parse_vec3("--env", a.env);
   // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
   // not for whitted, whose rays go one at a time.
@@ -288,6 +316,20 @@ RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string
            " has no emissive surface: a uniform white sky lights it too (--env 1,1,1; --env 0,0,0 for none)";
   }
   return s;
+}
+
+std::string black_image_warning(const RenderSettings& s, const Scene& scene) {
+  std::string why;
+  if (s.integrator == Integrator::Path) {
+    why = scene.emitters.empty() && max_component(s.environment) == 0.0f
+              ? "the scene has no emissive surface and --env is black"
+              : "no light reaches what the camera sees (an emitter out of view or too small, or --exposure too low)";
+  } else {
+    why = scene.lights.empty() && s.ambient == 0.0f ? "the scene has no light and --ambient is 0"
+                                                    : "no light reaches what the camera sees";
+  }
+  return "the image is black: " + why +
+         "; --integrator path --env 1,1,1 lights it with a white sky, --light x,y,z adds a point light";
 }
 
 AccelOptions accel_options_for(const RenderArgs& a) {

@@ -12,6 +12,7 @@
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
+#include "scene/obj_loader.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer::cli {
@@ -24,6 +25,8 @@ struct SceneArgs {
   std::vector<std::string> lights;
   bool no_scene_lights = false;
   std::optional<double> light_intensity;
+  uint64_t max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the OBJ
+  uint64_t max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
 };
 
 // The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,
@@ -65,13 +68,18 @@ void add_render_options(CLI::App& app, RenderArgs& args);
 // Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.
 // "-" reads the OBJ from standard input. `quiet` drops the loader's warnings.
 Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr);
+// Two paths name the same file: the same inode if both exist, else the same absolute path.
+bool same_file(const std::string& a, const std::string& b);
 // -o and --stats-json: known formats, writable, and neither of them the input scene or each other.
 void check_outputs(const RenderArgs& args);
+// Once the scene is loaded: no output (every frame's, --stats-json) is a file the load read (the
+// OBJ, its MTL files and textures, a views file), by identity; throws UsageError.
+void check_outputs_against_inputs(const RenderArgs& args);
 CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 // Frame `frame` of `frames`: `spec` with its eye turned about the look point, around the up
 // axis, by orbit_degrees * frame / frames (so 360 over N frames loops without a repeated frame).
 CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double orbit_degrees);
-// The output of frame `frame`: `output` itself for a single frame, else NAME-0007.EXT.
+// The output of frame `frame`: `output` itself for a single frame, else NAME-0007.EXT (more digits past 10,000 frames).
 std::string frame_output(const std::string& output, int frame, int frames);
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
@@ -80,6 +88,8 @@ inline constexpr int kDefaultPathSpp = 64;
 // surface and no --env is lit by a uniform white sky as well as any point lights (a point light
 // alone leaves everything it does not see black), and `note` says so.
 RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
+// Said whenever a finished image is black in every pixel: why, and the flags that light it.
+std::string black_image_warning(const RenderSettings& settings, const Scene& scene);
 AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);

@@ -1,5 +1,6 @@
 #include "io/image_io.hpp"
 
+#include <fcntl.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <sys/stat.h>
@@ -8,11 +9,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 
 #include "base/errors.hpp"
+#include "io/read_input.hpp"
 
 namespace tracer {
 
@@ -47,36 +50,104 @@ ImageFormat image_format_for(const std::string& path, const std::string& flag) {
   throw UsageError(flag + ": unsupported image extension '" + ext + "' in '" + path + "' (use .png, .ppm or .exr)");
 }
 
-void check_writable(const std::string& path) {
-  fs::path dir = fs::path(path).parent_path();
-  if (dir.empty()) dir = ".";
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw InputError(path + ": cannot write: directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
-  if (fs::is_directory(path, ec)) throw InputError(path + ": cannot write: is a directory");
+// Where a write to `path` lands: symbolic links followed to the file they name (which may not
+// exist yet). Throws InputError on a link loop.
+std::string resolve_output(const std::string& path) {
+  struct stat existing {};
+  if (::stat(path.c_str(), &existing) == 0) {
+    // A device or FIFO is opened by the name given: /dev/stdout's link names "pipe:[N]", which
+    // only the kernel can follow.
+    if (!S_ISREG(existing.st_mode)) return path;
+    char real[PATH_MAX];
+    if (::realpath(path.c_str(), real)) return real;
+  }
+  std::string at = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    struct stat st {};
+    if (::lstat(at.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return at;
+    std::string target(size_t(st.st_size > 0 ? st.st_size : 4096) + 1, '\0');
+    const ssize_t n = ::readlink(at.c_str(), target.data(), target.size());
+    if (n < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+    target.resize(size_t(n));
+    const fs::path link(at);
+    at = target.front() == '/' ? target : (link.parent_path() / target).string();
+  }
+  throw InputError(path + ": cannot write: too many levels of symbolic links (a link loop?)");
 }
 
-void write_file_atomic(const std::string& path, std::string_view bytes) {
-  check_writable(path);
-  std::string tmp = path + ".tmp-XXXXXX";
-  const int fd = ::mkstemp(tmp.data());
-  if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
-  const PendingTemp pending(tmp);
-  ::fchmod(fd, 0644);
+namespace {
+
+// A device node, FIFO or socket: written into, never replaced (/dev/stdout, /dev/null, a pipe).
+bool is_special(const std::string& resolved) {
+  struct stat st {};
+  return ::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
+void write_all(int fd, std::string_view bytes, const std::string& path) {
   size_t written = 0;
   while (written < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const std::string reason = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw InputError(path + ": cannot write: " + reason);
+      throw InputError(path + ": cannot write: " + std::strerror(errno));
     }
     written += size_t(n);
   }
-  if (::close(fd) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+}
+
+}  // namespace
+
+void check_writable(const std::string& path) {
+  const std::string target = resolve_output(path);
+  std::error_code ec;
+  if (fs::is_directory(target, ec)) throw InputError(path + ": cannot write: is a directory");
+  if (is_special(target)) {
+    if (::access(target.c_str(), W_OK) != 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+    return;
+  }
+  fs::path dir = fs::path(target).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec))
+    throw InputError(path + ": cannot write: directory '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+}
+
+void check_output(const std::string& path, const std::string& flag) {
+  check_not_an_input(path, flag);  // stat() follows links: the identity of what would be written
+  check_writable(path);
+}
+
+void write_file_atomic(const std::string& path, std::string_view bytes) {
+  check_writable(path);
+  check_not_an_input(path, "output");
+  const std::string target = resolve_output(path);
+  if (is_special(target)) {
+    int fd;
+    while ((fd = ::open(target.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC)) < 0 && errno == EINTR) {
+    }
+    if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+    try {
+      write_all(fd, bytes, path);
+    } catch (...) {
+      ::close(fd);
+      throw;
+    }
+    ::close(fd);
+    return;
+  }
+  std::string tmp = target + ".tmp-XXXXXX";
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  const PendingTemp pending(tmp);
+  ::fchmod(fd, 0644);
+  try {
+    write_all(fd, bytes, path);
+  } catch (...) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  if (::close(fd) != 0 || std::rename(tmp.c_str(), target.c_str()) != 0) {
     const std::string reason = std::strerror(errno);
     ::unlink(tmp.c_str());
     throw InputError(path + ": cannot write: " + reason);

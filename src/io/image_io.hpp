@@ -22,16 +22,26 @@ void write_image(const std::string& path, const Image8& image);
 // linear radiance (half or float), no tone mapping.
 void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel);
 
-// Writes bytes to path via temp file + rename; throws InputError on failure.
+// Writes bytes to `path`. A regular file (or none) is replaced atomically through a temporary file
+// in its directory and a rename; a symbolic link is followed and its target replaced so; a device
+// node or FIFO (/dev/stdout, /dev/null) is written into, never replaced. Throws InputError on
+// failure, UsageError when the target is a file this run read as input.
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
 // Removes the temporary file of a write_file_atomic() in progress, if any. Async-signal-safe: for a
 // signal handler that ends the process in the middle of a write.
 void remove_pending_temp_file();
 
-// Checks up front that `path`'s directory exists and is writable, so a long render does not end
-// in an unwritable path; throws InputError.
+// Checks up front that `path` (followed through symbolic links) can be written: its directory
+// exists and is writable, or it is a writable device or FIFO; throws InputError.
 void check_writable(const std::string& path);
+
+// check_writable(), and that `path` is no file this run has read (check_not_an_input): for every
+// output of a command, once its inputs are loaded, so nothing is written when one collides.
+void check_output(const std::string& path, const std::string& flag);
+
+// Where a write to `path` lands: symbolic links followed (the target may not exist yet).
+std::string resolve_output(const std::string& path);
 
 // Reads a PNG or PPM written by write_image (tests, image comparison); throws InputError.
 Image8 read_image(const std::string& path);

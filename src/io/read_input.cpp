@@ -7,6 +7,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <mutex>
+#include <vector>
 
 namespace tracer {
 namespace {
@@ -30,12 +32,40 @@ std::string reason(int err) {
   }
 }
 
+// The regular files read so far: loaders may run on several threads (textures), so a mutex.
+struct InputFile {
+  dev_t dev;
+  ino_t ino;
+  std::string name;
+};
+std::mutex g_inputs_mutex;
+std::vector<InputFile> g_inputs;
+
+void remember_input(const struct stat& st, const std::string& name) {
+  if (!S_ISREG(st.st_mode)) return;
+  const std::lock_guard lock(g_inputs_mutex);
+  for (const InputFile& f : g_inputs) {
+    if (f.dev == st.st_dev && f.ino == st.st_ino) return;
+  }
+  g_inputs.push_back({st.st_dev, st.st_ino, name});
+}
+
+std::string mib(uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
 }  // namespace
 
-std::string read_input(const std::string& path, CancelFlag cancel) {
+std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
   const bool stdin_input = path == "-";
   const std::string name = stdin_input ? "<stdin>" : path;
-  const int fd = stdin_input ? STDIN_FILENO : ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (path.empty()) throw InputError("an empty file name was given");
+  int fd = STDIN_FILENO;
+  if (!stdin_input) {
+    // Opening a FIFO blocks until a writer comes; a signal interrupts the wait (no SA_RESTART),
+    // and then the cancel flag says whether to stop or to wait on.
+    while ((fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC)) < 0 && errno == EINTR) {
+      throw_if_cancelled(cancel);
+    }
+  }
   if (fd < 0) throw InputError(name + ": cannot open: " + reason(errno));
   struct Closer {
     int fd;
@@ -47,6 +77,11 @@ std::string read_input(const std::string& path, CancelFlag cancel) {
   struct stat st {};
   if (::fstat(fd, &st) != 0) throw InputError(name + ": cannot open: " + reason(errno));
   if (S_ISDIR(st.st_mode)) throw InputError(name + ": cannot open: is a directory");
+  const auto too_large = [&] {
+    return InputTooLarge(name + ": larger than " + mib(max_bytes) + ", the limit for this input (README: Limits)");
+  };
+  if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes) throw too_large();
+  remember_input(st, name);
   std::string bytes;
   if (S_ISREG(st.st_mode)) bytes.reserve(size_t(st.st_size));
   constexpr size_t kChunk = 1 << 20;
@@ -57,6 +92,7 @@ std::string read_input(const std::string& path, CancelFlag cancel) {
     pollfd pfd{fd, POLLIN, 0};
     const int ready = ::poll(&pfd, 1, 100);
     if (ready == 0 || (ready < 0 && errno == EINTR)) continue;
+    if (bytes.size() > max_bytes) throw too_large();
     const size_t old = bytes.size();
     bytes.resize(old + kChunk);
     const ssize_t n = ::read(fd, bytes.data() + old, kChunk);
@@ -70,7 +106,19 @@ std::string read_input(const std::string& path, CancelFlag cancel) {
     bytes.resize(old + size_t(n));
     if (n == 0) break;
   }
+  if (bytes.size() > max_bytes) throw too_large();
   return bytes;
+}
+
+void check_not_an_input(const std::string& path, const std::string& flag) {
+  struct stat st {};
+  if (path.empty() || path == "-" || ::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+  const std::lock_guard lock(g_inputs_mutex);
+  for (const InputFile& f : g_inputs) {
+    if (f.dev == st.st_dev && f.ino == st.st_ino) {
+      throw UsageError(flag + ": '" + path + "' is an input of this run (" + f.name + ")");
+    }
+  }
 }
 
 }  // namespace tracer

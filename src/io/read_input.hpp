@@ -1,15 +1,34 @@
 // Reading an input file whole, once: regular files, pipes, FIFOs and "-" (standard input) alike.
+// Every regular file read is remembered by identity (device and inode), so no output of the run
+// can replace an input, whatever name either is given by.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "base/errors.hpp"
 
 namespace tracer {
 
+// The largest input read_input() accepts unless told otherwise: 4 GiB (a 5M-triangle OBJ is
+// about 300 MiB). `tracer render --max-input-mib` raises it for a scene.
+inline constexpr uint64_t kDefaultMaxInputBytes = uint64_t(4096) << 20;
+
+// More bytes than the limit arrived: not a missing or unreadable file, so never only a warning.
+class InputTooLarge : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 // The bytes of `path` ("-": standard input). Throws InputError("PATH: cannot open: reason") with
-// the real reason (no such file, permission denied, a symlink loop, a directory), and Cancelled
-// when `cancel` is set while reading.
-std::string read_input(const std::string& path, CancelFlag cancel = nullptr);
+// the real reason (no such file, permission denied, a symlink loop, a directory), InputTooLarge
+// when more than `max_bytes` arrive (a file that never ends: /dev/zero, a runaway pipe), and Cancelled
+// when `cancel` is set while opening or reading (a FIFO with no writer, a silent pipe).
+std::string read_input(const std::string& path, CancelFlag cancel = nullptr,
+                       uint64_t max_bytes = kDefaultMaxInputBytes);
+
+// Throws UsageError("FLAG: 'PATH' is an input of this run (INPUT)") when `path`, followed through
+// symbolic links, is a regular file this process has read with read_input().
+void check_not_an_input(const std::string& path, const std::string& flag);
 
 }  // namespace tracer

@@ -69,6 +69,7 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
     const auto t0 = Clock::now();
     s.scene.emplace(cli::load_scene(args.scene, args.quiet || !session.root()));
     s.load_ms = ms_since(t0);
+    if (session.root()) cli::check_outputs_against_inputs(args);
     s.camera = cli::camera_for(*s.scene, args);
     std::string note;
     s.settings = cli::settings_for(args, *s.scene, note);
@@ -278,6 +279,9 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     }
     if (session.root()) {
       write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
+      if (frame == 0 && looks_black(*fb, settings.exposure)) {
+        say("tracer-mpi: warning: " + output + ": " + cli::black_image_warning(settings, scene));
+      }
     }
   }
   if (progress) progress->stop();

@@ -54,13 +54,16 @@ inline bool light_sample(const SurfacePoint& sp, const Light& light, Ray& shadow
 // pixel's colour.
 template <class Accel>
 Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfacePoint& sp,
-                         RayCounts& counts) {
+                         RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
   float unoccluded = 1.0f;
   if (s.ao_samples > 0) {
     const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
+    // Sample k of the pixel takes AO rays k * ao_samples ... of its stream: distinct per sample,
+    // and sample 0's are the one-sample image's.
+    const uint32_t first_ray = sample * uint32_t(s.ao_samples);
     const auto direction = [&](int i) {
-      const SampleRng rng(pixel, uint32_t(i), s.seed);
+      const SampleRng rng(pixel, first_ray + uint32_t(i), s.seed);
       return ao_direction(sp.n, rng.draw(0), rng.draw(1));
     };
     int open = 0;
@@ -109,11 +112,11 @@ void add_direct_light(const Accel& accel, const RenderContext& ctx, SurfacePoint
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
 template <class Accel>
 Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
-               RayCounts& counts) {
+               RayCounts& counts, uint32_t sample = 0) {
   if (!hit.valid()) return Vec3{0.0f};
   SurfacePoint sp = surface_point(ctx, primary, hit);
   add_direct_light(accel, ctx, sp, counts);
-  return finish_with_ambient(accel, ctx, x, y, sp, counts);
+  return finish_with_ambient(accel, ctx, x, y, sp, counts, sample);
 }
 
 template <class Accel>

@@ -39,4 +39,14 @@ Image8 tonemap(const Framebuffer& fb, float exposure) {
   return img;
 }
 
+bool looks_black(const Framebuffer& fb, float exposure) {
+  for (int y = 0; y < fb.height(); ++y) {
+    for (int x = 0; x < fb.width(); ++x) {
+      const Vec3 c = fb.radiance(x, y);
+      if (encode(c.x, exposure) != 0 || encode(c.y, exposure) != 0 || encode(c.z, exposure) != 0) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace tracer

@@ -66,4 +66,7 @@ struct Image8 {
 // curve, rounded to 8 bits.
 Image8 tonemap(const Framebuffer& fb, float exposure);
 
+// Whether tonemap(fb, exposure) is black in every pixel: a render a user must be told about.
+bool looks_black(const Framebuffer& fb, float exposure);
+
 }  // namespace tracer

@@ -30,7 +30,7 @@ struct RenderControl {
 bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
                   RenderControl& control);
 
-// The passes of a render: ao and whitted take one sample per pixel; path takes settings.spp in
+// The passes of a render: settings.spp samples per pixel (ao and whitted: 1 by default) in
 // passes that double (1, 1, 2, 4, ... at most kMaxPassSamples), so a checkpoint or a stop finds
 // a complete image early and later passes keep the tile overhead small.
 inline constexpr uint32_t kMaxPassSamples = 64;

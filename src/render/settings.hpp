@@ -37,7 +37,7 @@ struct RenderSettings {
   uint32_t seed = 0;
   Integrator integrator = Integrator::Ao;
   int max_depth = 8;       // whitted: reflections and refractions followed; path: bounces per path
-  int spp = 1;             // path: samples per pixel
+  int spp = 1;             // samples per pixel (every integrator)
   Vec3 environment{0.0f};  // path: radiance arriving from every direction no surface blocks
   LightSampling light_sampling = LightSampling::Mis;
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's

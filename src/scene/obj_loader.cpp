@@ -21,6 +21,7 @@
 
 #include "base/text.hpp"
 #include "io/read_input.hpp"
+#include "scene/mtl_parser.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -44,8 +45,9 @@ float parse_coordinate(std::string_view tok, const std::string& name, size_t lin
   const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
   if (ec == std::errc{} && ptr == digits.data() + digits.size()) {
     if (!std::isfinite(value)) fail_at(name, line, "non-finite coordinate " + in_quotes(tok));
-    if (std::fabs(value) > double(kMaxCoordinate)) {
-      fail_at(name, line, "number out of range " + in_quotes(tok) + " (coordinates must lie within +-1e18)");
+    if (std::fabs(float(value)) > kMaxCoordinate) {
+      fail_at(name, line,
+              "number out of range " + in_quotes(tok) + " (coordinates must lie within +-" + kMaxCoordinateText + ")");
     }
     return float(value);
   }
@@ -140,38 +142,66 @@ class CancellableBuffer : public std::streambuf {
 };
 
 // Resolves `mtllib` names: from files beside the OBJ (each read once, like the OBJ), or from one
-// text in memory (tests, fuzzing).
+// text in memory (tests, fuzzing). Our own strict parser reads them (scene/mtl_parser.hpp):
+// tinyobjloader's reads `Kd 0.5` as red and a malformed number as 0.
 class MtlSource : public tinyobj::MaterialReader {
  public:
-  static MtlSource from_directory(fs::path dir) { return MtlSource(std::move(dir), {}, false); }
-  static MtlSource from_text(std::string text) { return MtlSource({}, std::move(text), true); }
+  static MtlSource from_directory(fs::path dir, CancelFlag cancel) {
+    return MtlSource(std::move(dir), {}, false, cancel);
+  }
+  static MtlSource from_text(std::string text) { return MtlSource({}, std::move(text), true, nullptr); }
 
   bool operator()(const std::string& mtl_name, std::vector<tinyobj::material_t>* materials,
-                  std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
+                  std::map<std::string, int>* material_map, std::string* warn, std::string*) override {
     std::string text;
+    std::string name = "<mtl>";
     if (in_memory_) {
       text = text_;
     } else {
       const fs::path path = dir_ / mtl_name;
+      name = path.string();
       try {
-        text = read_input(path.string());
+        text = read_input(name, cancel_, kMaxMtlBytes);
+      } catch (const InputTooLarge&) {
+        throw;  // a file that never ends is an error, not a missing material library
       } catch (const InputError& e) {
         if (warn) *warn += std::string(e.what()) + "\n";
         return false;
       }
     }
     strip_bom(text);
-    std::istringstream in(text);
-    tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+    for (const MtlMaterial& m : parse_mtl(text, name, cancel_)) {
+      tinyobj::material_t t;
+      t.name = m.name;
+      for (int i = 0; i < 3; ++i) {
+        t.ambient[i] = m.ka[i];
+        t.diffuse[i] = m.kd[i];
+        t.specular[i] = m.ks[i];
+        t.emission[i] = m.ke[i];
+        t.transmittance[i] = m.tf[i];
+      }
+      t.shininess = m.ns;
+      t.ior = m.ni;
+      t.dissolve = m.dissolve;
+      t.illum = m.illum;
+      t.diffuse_texname = m.diffuse_map;
+      t.bump_texname = m.bump_map;
+      material_map->insert({t.name, int(materials->size())});  // the first of a name wins
+      materials->push_back(std::move(t));
+    }
     return true;
   }
 
  private:
-  MtlSource(fs::path dir, std::string text, bool in_memory)
-      : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory) {}
+  // An MTL file is text of a few kilobytes; past this it is not one (/dev/zero, a runaway pipe).
+  static constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;
+
+  MtlSource(fs::path dir, std::string text, bool in_memory, CancelFlag cancel)
+      : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory), cancel_(cancel) {}
   fs::path dir_;
   std::string text_;
   bool in_memory_;
+  CancelFlag cancel_;
 };
 
 // Groups warnings by kind (the text with its quoted names and numbers left out), so 80,000
@@ -280,7 +310,7 @@ Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, War
 // Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
 // finite and within range, every face index inside the vertex array, material ids in range.
 Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings,
-                  CancelFlag cancel) {
+                  const LoadLimits& limits, CancelFlag cancel) {
   const tinyobj::attrib_t& attrib = parsed.attrib;
   Scene scene;
   scene.source = name;
@@ -298,24 +328,37 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
   size_t missing_textures = 0;
   std::string first_missing;
   std::map<fs::path, uint32_t> texture_index;
+  std::map<std::string, std::string> failed;  // name as the MTL gives it -> why it is not used
+  FileFinder finder;
+  uint64_t texture_bytes = 0;
   for (const tinyobj::material_t& m : parsed.materials) {
     Material mat = to_material(m, name);
     if (!m.diffuse_texname.empty()) {
       throw_if_cancelled(cancel);
-      const std::optional<fs::path> file = find_file_any_case(base_dir, m.diffuse_texname);
       std::string problem;
-      if (!file) {
+      if (const auto seen = failed.find(m.diffuse_texname); seen != failed.end()) {
+        problem = seen->second;
+      } else if (const std::optional<fs::path> file = finder.find(base_dir, m.diffuse_texname); !file) {
         problem = "not found";
       } else if (const auto it = texture_index.find(*file); it != texture_index.end()) {
         mat.diffuse_texture = it->second;
       } else {
         try {
-          scene.textures.push_back(load_texture(*file));
+          Texture texture = load_texture(*file, limits.textures, cancel);
+          const uint64_t bytes = texture.srgb().size();
+          if (texture_bytes + bytes > limits.textures.max_total_bytes) {
+            throw InputError("the scene's textures would take more than " +
+                             std::to_string(limits.textures.max_total_bytes >> 20) +
+                             " MiB (--max-texture-mib raises it)");
+          }
+          texture_bytes += bytes;
+          scene.textures.push_back(std::move(texture));
           mat.diffuse_texture = texture_index[*file] = static_cast<uint32_t>(scene.textures.size() - 1);
         } catch (const InputError& e) {
           problem = e.what();
         }
       }
+      if (!problem.empty()) failed.emplace(m.diffuse_texname, problem);
       if (!problem.empty() && missing_textures++ == 0) first_missing = in_quotes(m.diffuse_texname) + ": " + problem;
     }
     scene.materials.push_back(std::move(mat));
@@ -415,29 +458,29 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
 void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
 Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
-           const WarningSink& warn_in, CancelFlag cancel) {
+           const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits) {
   const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
   strip_bom(text);
   WarningLog warnings;
   const Parsed parsed = parse(text, name, mtl, warnings, cancel);
-  Scene scene = build_scene(parsed, name, base_dir, warnings, cancel);
+  Scene scene = build_scene(parsed, name, base_dir, warnings, limits, cancel);
   warnings.flush(name, warn);
   return scene;
 }
 
 }  // namespace
 
-Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel) {
-  std::string text = read_input(path, cancel);
+Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits) {
+  std::string text = read_input(path, cancel, limits.max_obj_bytes);
   const fs::path base_dir = path == "-" ? fs::path() : fs::path(path).parent_path();
   return load(text, path == "-" ? std::string("<stdin>") : path, base_dir,
-              MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir), warn, cancel);
+              MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir, cancel), warn, cancel, limits);
 }
 
 Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
                            const WarningSink& warn) {
   std::string text = obj_text;
-  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr);
+  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr, LoadLimits{});
 }
 
 }  // namespace tracer

@@ -8,7 +8,9 @@
 #include <string>
 
 #include "base/errors.hpp"
+#include "io/read_input.hpp"
 #include "scene/scene.hpp"
+#include "scene/texture.hpp"
 
 namespace tracer {
 
@@ -20,7 +22,14 @@ using WarningSink = std::function<void(const std::string&)>;
 // including a pipe; "-" reads standard input (MTL files then resolve from the current directory).
 // Throws InputError with a one-line message naming the file and, where there is one, the line;
 // Cancelled when `cancel` is set during loading.
-Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr);
+// What a load may read: the OBJ's size (MTL files: 64 MiB each) and the textures' texels.
+struct LoadLimits {
+  uint64_t max_obj_bytes = kDefaultMaxInputBytes;
+  TextureLimits textures;
+};
+
+Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr,
+               const LoadLimits& limits = {});
 
 // The same from memory (fuzzing, tests); `name` stands for the file in messages, and `mtl_text`
 // serves every `mtllib` the OBJ names.

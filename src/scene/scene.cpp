@@ -1,7 +1,10 @@
 #include "scene/scene.hpp"
 
 #include <map>
+#include <string>
 #include <utility>
+
+#include "base/errors.hpp"
 
 namespace tracer {
 
@@ -67,6 +70,10 @@ void Scene::finalize() {
     l.power = a.ke * a.area;
     l.area = a.area;
     l.geomID = key.first;
+    if (!is_finite(l.position) || !is_finite(l.power)) {
+      throw InputError(source + ": the emissive surface of geometry " + std::to_string(key.first) + " (material " +
+                       std::to_string(key.second) + ") has a light of non-finite position or power");
+    }
     lights.push_back(l);
   }
   emitters = Emitters(*this);

@@ -1,13 +1,16 @@
 #include "scene/texture.hpp"
 
 #include <stb_image.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <limits>
 
 #include "base/errors.hpp"
+#include "io/read_input.hpp"
 
 namespace tracer {
 
@@ -57,21 +60,38 @@ Vec3 Texture::bilinear(float u, float v) const {
          (texel(x0, y1) * (1.0f - ax) + texel(x1, y1) * ax) * ay;
 }
 
-Texture load_texture(const fs::path& path) {
+Texture load_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
+  const std::string name = path.string();
+  struct stat st {};
+  if (::stat(name.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw InputError(name + ": not a regular file" + (S_ISFIFO(st.st_mode) ? " (a FIFO)" : ""));
+  }
+  // The encoded file is far smaller than its texels; a file this large is no texture.
+  const std::string bytes = read_input(name, cancel, limits.max_texels * 3 + (uint64_t(64) << 20));
+  if (bytes.size() > size_t(std::numeric_limits<int>::max())) throw InputError(name + ": too large to decode");
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int size = int(bytes.size());
   int w = 0, h = 0, channels = 0;
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
-  if (!data) throw InputError(path.string() + ": cannot read texture: " + stbi_failure_reason());
-  std::vector<uint8_t> texels(data, data + size_t(w) * size_t(h) * 3);
-  stbi_image_free(data);
-  return Texture(w, h, std::move(texels));
+  if (!stbi_info_from_memory(data, size, &w, &h, &channels)) {
+    throw InputError(name + ": cannot read texture: " + stbi_failure_reason());
+  }
+  if (uint64_t(w) * uint64_t(h) > limits.max_texels) {
+    throw InputError(name + ": " + std::to_string(w) + "x" + std::to_string(h) + " texels, more than the " +
+                     std::to_string(limits.max_texels) + " a texture may have");
+  }
+  unsigned char* texels = stbi_load_from_memory(data, size, &w, &h, &channels, 3);
+  if (!texels) throw InputError(name + ": cannot read texture: " + stbi_failure_reason());
+  std::vector<uint8_t> srgb(texels, texels + size_t(w) * size_t(h) * 3);
+  stbi_image_free(texels);
+  return Texture(w, h, std::move(srgb));
 }
 
-std::optional<fs::path> find_file_any_case(const fs::path& dir, const std::string& name) {
+std::optional<fs::path> FileFinder::find(const fs::path& dir, const std::string& name) {
   std::error_code ec;
   std::string normalised = name;
   std::replace(normalised.begin(), normalised.end(), '\\', '/');  // MTL files written on Windows
   const fs::path relative(normalised);
-  if (fs::is_regular_file(dir / relative, ec)) return dir / relative;
+  if (fs::exists(fs::symlink_status(dir / relative, ec))) return dir / relative;
   fs::path at = dir.empty() ? fs::path(".") : dir;
   for (const fs::path& part : relative) {
     if (part == ".") continue;
@@ -79,15 +99,24 @@ std::optional<fs::path> find_file_any_case(const fs::path& dir, const std::strin
       at /= part;
       continue;
     }
-    const std::string want = lower(part.string());
-    std::optional<fs::path> match;  // the first in byte order, if several differ only in case
-    for (fs::directory_iterator it(at, ec), end; !ec && it != end; it.increment(ec)) {
-      if (lower(it->path().filename().string()) == want && (!match || it->path() < *match)) match = it->path();
+    auto [listing, fresh] = listings_.try_emplace(at);
+    if (fresh) {
+      for (fs::directory_iterator it(at, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string key = lower(it->path().filename().string());
+        const auto [entry, inserted] = listing->second.try_emplace(key, it->path());
+        if (!inserted && it->path() < entry->second) entry->second = it->path();  // first in byte order
+      }
     }
-    if (!match) return std::nullopt;
-    at = *match;
+    const auto match = listing->second.find(lower(part.string()));
+    if (match == listing->second.end()) return std::nullopt;
+    at = match->second;
   }
-  return fs::is_regular_file(at, ec) ? std::optional<fs::path>(at) : std::nullopt;
+  return fs::exists(fs::symlink_status(at, ec)) && !fs::is_directory(at, ec) ? std::optional<fs::path>(at)
+                                                                             : std::nullopt;
+}
+
+std::optional<fs::path> find_file_any_case(const fs::path& dir, const std::string& name) {
+  return FileFinder().find(dir, name);
 }
 
 }  // namespace tracer

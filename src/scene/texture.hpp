@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "base/errors.hpp"
 #include "math/vec.hpp"
 
 namespace tracer {
@@ -31,12 +33,32 @@ class Texture {
   std::vector<uint8_t> srgb_;
 };
 
-// Decodes any image stb_image reads (PNG, JPEG, ...). Throws InputError naming the file.
-Texture load_texture(const std::filesystem::path& path);
+// What a scene's textures may take: a texture larger than max_texels is refused (a decompression
+// bomb: a 5 KB JPEG header can claim 26000 x 26000), and so is any texture past the total.
+struct TextureLimits {
+  uint64_t max_texels = uint64_t(8192) * 8192;  // 192 MiB as 8-bit RGB
+  uint64_t max_total_bytes = uint64_t(2048) << 20;
+};
 
-// The file `name` (relative, as an MTL writes it) under `dir`: the exact path if it exists, or
-// else the one whose every component matches ignoring letter case (files written on Windows name
-// "KAMEN.JPG" for kamen.jpg); nothing if neither exists.
+// Decodes any image stb_image reads (PNG, JPEG, ...) after reading its header: throws InputError
+// naming the file when it cannot be read, is not a regular file, or is larger than
+// `limits.max_texels`. Cancelled when `cancel` is set while reading.
+Texture load_texture(const std::filesystem::path& path, const TextureLimits& limits = {}, CancelFlag cancel = nullptr);
+
+// The file `name` (relative, as an MTL writes it) under `dir`: the exact path if it exists (of
+// any type: reading it says what is wrong with it), or else the one whose every component
+// matches ignoring letter case (files written on Windows name "KAMEN.JPG" for kamen.jpg);
+// nothing if neither exists. Each directory is listed once, however many names are looked up.
+class FileFinder {
+ public:
+  std::optional<std::filesystem::path> find(const std::filesystem::path& dir, const std::string& name);
+
+ private:
+  // Per directory: lower-cased file name to the first such entry in byte order.
+  std::map<std::filesystem::path, std::map<std::string, std::filesystem::path>> listings_;
+};
+
+// One look-up with a finder of its own.
 std::optional<std::filesystem::path> find_file_any_case(const std::filesystem::path& dir, const std::string& name);
 
 }  // namespace tracer

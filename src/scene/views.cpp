@@ -53,7 +53,7 @@ std::string default_views_path() {
   return "../shared/scenes/views.tsv";
 }
 
-std::optional<View> view_of_scene_file(const std::string& obj_path) {
+std::optional<View> view_of_scene_file(const std::string& obj_path, std::string* problem) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path dir = fs::path(obj_path).parent_path();
@@ -62,7 +62,8 @@ std::optional<View> view_of_scene_file(const std::string& obj_path) {
     std::vector<View> views;
     try {
       views = load_views(candidate.string());
-    } catch (const InputError&) {
+    } catch (const std::runtime_error& e) {
+      if (problem && problem->empty()) *problem = e.what();
       continue;
     }
     for (const View& v : views) {
@@ -73,7 +74,7 @@ std::optional<View> view_of_scene_file(const std::string& obj_path) {
 }
 
 std::vector<View> load_views(const std::string& path) {
-  std::string text = read_input(path);
+  std::string text = read_input(path, nullptr, uint64_t(64) << 20);  // a views file is a few lines
   strip_bom(text);
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   std::vector<View> views;
@@ -111,13 +112,14 @@ std::vector<View> load_views(const std::string& path) {
   return views;
 }
 
-const View& find_view(const std::vector<View>& views, const std::string& name, const std::string& path) {
+const View& find_view(const std::vector<View>& views, const std::string& name, const std::string& path,
+                      const std::string& flag) {
   std::string names;
   for (const View& v : views) {
     if (v.name == name) return v;
     names += (names.empty() ? "" : ", ") + v.name;
   }
-  throw InputError(path + ": no view called " + in_quotes(name) + " (" + names + ")");
+  throw UsageError(flag + ": no view called " + in_quotes(name) + " in " + path + " (" + names + ")");
 }
 
 void apply_view_light(Scene& scene, const View& view) {

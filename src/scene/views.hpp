@@ -25,15 +25,18 @@ struct View {
 std::string default_views_path();
 
 // The view a views.tsv beside the scene (in its directory or the one above) gives for the file
-// at `obj_path`, if any; a views file that cannot be read or parsed counts as none.
-std::optional<View> view_of_scene_file(const std::string& obj_path);
+// at `obj_path`, if any. A views file that cannot be read or parsed counts as none, and the first
+// such error goes to `problem` (for a warning).
+std::optional<View> view_of_scene_file(const std::string& obj_path, std::string* problem = nullptr);
 
 // Reads a views file: a header line (scene, obj, eye, look, up, fov, light, note), then one view
 // per line, fields separated by tabs, vectors as x,y,z. Throws InputError naming file:line.
 std::vector<View> load_views(const std::string& path);
 
-// The view called `name`; throws InputError listing the names in `path` when there is none.
-const View& find_view(const std::vector<View>& views, const std::string& name, const std::string& path);
+// The view called `name`; throws UsageError naming `flag` and listing the names in `path` when
+// there is none.
+const View& find_view(const std::vector<View>& views, const std::string& name, const std::string& path,
+                      const std::string& flag = "--view");
 
 // Replaces the scene's lights with the view's point light (Scene::default_light_intensity()).
 void apply_view_light(Scene& scene, const View& view);

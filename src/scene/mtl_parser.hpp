@@ -1,0 +1,40 @@
+// The MTL format (Wavefront's material library), read strictly: every numeric statement as the
+// format defines it (`Kd r [g b]`, one value meaning grey), every value range-checked, and any
+// malformed or out-of-range value an error naming file:line. Tokens are separated by any run of
+// spaces and tabs; `#` starts a comment anywhere on a line (exporters glue them to numbers).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "base/errors.hpp"
+#include "math/vec.hpp"
+
+namespace tracer {
+
+// One `newmtl` block as written; defaults are the format's (and tinyobjloader's): black colours,
+// Ns 1, Ni 1, d 1, illum 0.
+struct MtlMaterial {
+  std::string name;
+  Vec3 ka{0.0f}, kd{0.0f}, ks{0.0f}, ke{0.0f}, tf{0.0f};
+  float ns = 1.0f, ni = 1.0f, dissolve = 1.0f;
+  int illum = 0;
+  std::string diffuse_map;       // map_Kd's file name, its options dropped
+  std::string bump_map;          // map_bump / bump
+  float bump_multiplier = 1.0f;  // its -bm
+  size_t line = 0;               // where `newmtl` stands
+};
+
+// Ranges a value must lie in (the format's, or what the renderer can carry without overflow).
+inline constexpr float kMaxReflectance = 1.0f;  // Ka Kd Ks Tf: fractions of light
+inline constexpr float kMaxEmission = 1e6f;     // Ke: radiance, far above any real lamp's ratio
+inline constexpr float kMaxShininess = 1e6f;    // Ns
+inline constexpr float kMaxIor = 100.0f;        // Ni (0 is accepted: exporters write it for "unset")
+
+// Parses MTL text; `name` stands for the file in messages. Throws InputError("name:line: ...").
+// Statements the renderer does not use (map_Ks, Pr, ...) are skipped; a spectral colour
+// (`Kd spectral file.rfl`) is an error, as tracer renders RGB.
+std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name, CancelFlag cancel = nullptr);
+
+}  // namespace tracer

@@ -1,0 +1,381 @@
+// Hostile inputs and outputs (docs/RELIABILITY.md): outputs that are device nodes, FIFOs,
+// symbolic links or inputs; coordinates at the edge of the accepted range; MTL values; inputs
+// that never end; texture decompression bombs; black images; anti-aliasing for every integrator.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "base/errors.hpp"
+#include "scene/mtl_parser.hpp"
+#include "scene/obj_loader.hpp"
+#include "scene/texture.hpp"
+#include "test_util.hpp"
+
+namespace tracer {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Hardening : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::temp_dir();
+    std::ofstream(dir_ + "/tri.obj") << "mtllib tri.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                     << "usemtl a\nf 1/1 2/2 3/3\n";
+    std::ofstream(dir_ + "/tri.mtl") << "newmtl a\nKd 0.5\nmap_Kd s-0001.png\n";
+    const unsigned char texel[3] = {200, 100, 50};
+    // A 1x1 PNG written by hand is long; an uncompressed PPM is a texture stb reads too.
+    std::ofstream(dir_ + "/s-0001.png", std::ios::binary) << "P6\n1 1\n255\n"
+                                                          << std::string(reinterpret_cast<const char*>(texel), 3);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string in(const std::string& name) const { return dir_ + "/" + name; }
+  std::string dir_;
+};
+
+TEST_F(Hardening, ASymlinkOutputReplacesItsTargetAndStaysALink) {
+  fs::create_symlink("target.png", in("link.png"));
+  const auto r = test::run_tracer("render " + in("tri.obj") + " -q --width 8 --height 8 -o " + in("link.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::is_symlink(in("link.png")));
+  EXPECT_TRUE(fs::is_regular_file(in("target.png")));
+}
+
+TEST_F(Hardening, AFifoOutputIsWrittenIntoNotReplaced) {
+  ASSERT_EQ(::mkfifo(in("stats.json").c_str(), 0644), 0);
+  std::string received;
+  std::thread reader([&] { received = slurp(in("stats.json")); });
+  const auto r = test::run_tracer("render " + in("tri.obj") + " -q --width 8 --height 8 -o " + in("o.png") +
+                                  " --stats-json " + in("stats.json"));
+  reader.join();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  struct stat st {};
+  ASSERT_EQ(::stat(in("stats.json").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_NE(received.find("\"rays\""), std::string::npos) << received;
+}
+
+TEST_F(Hardening, ADeviceNodeOutputIsWrittenIntoNotReplaced) {
+  if (::geteuid() != 0) GTEST_SKIP() << "mknod of a character device needs root";
+  // A copy of /dev/null and one of /dev/full in the test's own directory.
+  ASSERT_EQ(::mknod(in("null").c_str(), S_IFCHR | 0666, makedev(1, 3)), 0);
+  ASSERT_EQ(::mknod(in("full").c_str(), S_IFCHR | 0666, makedev(1, 7)), 0);
+  const std::string render = "render " + in("tri.obj") + " -q --width 8 --height 8 -o " + in("o.png");
+  auto r = test::run_tracer(render + " --stats-json " + in("null"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_tracer(render + " --stats-json " + in("full"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("No space left on device"), std::string::npos) << r.output;
+  for (const char* name : {"null", "full"}) {
+    struct stat st {};
+    ASSERT_EQ(::stat(in(name).c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << name;
+  }
+}
+
+TEST_F(Hardening, NoOutputMayBeAnInputByAnyName) {
+  const std::string mtl = slurp(in("tri.mtl")), texture = slurp(in("s-0001.png"));
+  fs::create_symlink("tri.mtl", in("alias.json"));
+  const std::string render = "render " + in("tri.obj") + " -q --width 8 --height 8";
+  const std::pair<std::string, std::string> cases[] = {
+      {render + " --stats-json " + in("tri.mtl"), "--stats-json: '" + in("tri.mtl") + "' is an input of this run"},
+      {render + " --stats-json " + in("alias.json"), "is an input of this run"},
+      {render + " -o " + in("s-0001.png"), "-o: '" + in("s-0001.png") + "' is an input of this run"},
+      // The second frame's name is the texture.
+      {render + " --frames 2 -o " + in("s.png"), "-o: '" + in("s-0001.png") + "' is an input of this run"},
+      {"bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes " + in("tri.obj") + " --plot " + in("tri.obj"),
+       "--plot: '" + in("tri.obj") + "' is an input of this run"},
+      {"bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes " + in("tri.obj") + " --json " + in("tri.mtl"),
+       "--json: '" + in("tri.mtl") + "' is an input of this run"},
+  };
+  for (const auto& [args, message] : cases) {
+    SCOPED_TRACE(args);
+    const auto r = test::run_tracer(args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(slurp(in("tri.mtl")), mtl);
+  EXPECT_EQ(slurp(in("s-0001.png")), texture);
+  EXPECT_FALSE(fs::exists(in("s-0000.png")));  // nothing written, not even the first frame
+}
+
+// Every accelerator renders a triangle spanning the whole accepted range, the same image, and
+// the next float past the range is refused.
+TEST_F(Hardening, CoordinatesAtTheEdgeOfTheRangeRenderOnEveryAccelerator) {
+  std::ofstream(in("edge.obj")) << "v -1e12 -1e12 0\nv 1e12 -1e12 0\nv 0 1e12 0\nf 1 2 3\n";
+  std::ofstream(in("past.obj")) << "v -1.0001e12 -1e12 0\nv 1e12 -1e12 0\nv 0 1e12 0\nf 1 2 3\n";
+  std::string reference;
+  for (const char* accel : {"brute", "bvh", "bvh8", "embree"}) {
+    SCOPED_TRACE(accel);
+    const std::string out = in(std::string(accel) + ".ppm");
+    const auto r = test::run_tracer("render " + in("edge.obj") + " -q --integrator ao --ao 0 --width 16 --height 16" +
+                                    " --accel " + accel + " -o " + out);
+    if (std::string(accel) == "embree" && r.exit_code == 2) continue;  // a build without Embree
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string image = slurp(out);
+    EXPECT_NE(image.find_first_not_of('\0', image.size() - 16 * 16 * 3), std::string::npos) << "all black";
+    if (reference.empty()) reference = image;
+    EXPECT_EQ(image, reference);
+  }
+  const auto r = test::run_tracer("render " + in("past.obj") + " -q -o " + in("p.png"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("past.obj:1: number out of range '-1.0001e12' (coordinates must lie within +-1e12)"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST_F(Hardening, ANarrowFovThatBacksTheCameraOutOfRangeIsRefused) {
+  std::ofstream(in("wide.obj")) << "v -1e10 -1e10 0\nv 1e10 -1e10 0\nv 0 1e10 0\nf 1 2 3\n";
+  auto r = test::run_tracer("render " + in("wide.obj") + " -q --fov 0.01 -o " + in("w.png"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--fov: 0.010000 degrees frames this scene from too far away"), std::string::npos)
+      << r.output;
+  for (const char* accel : {"bvh8", "embree"}) {
+    r = test::run_tracer("render -q --fov 1e-30 --accel " + std::string(accel) + " -o " + in("w.png"));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+  }
+}
+
+TEST(MtlParser, ReadsEveryNumericStatementAsTheFormatSays) {
+  const std::vector<MtlMaterial> m = parse_mtl(
+      "# comment\nnewmtl  Grey\t\nKd 0.5\nKs 0.1 0.2 0.3\nKe 17 12 4# glued comment\nNs 10\nNi 1.5\nd 0.25\n"
+      "Tr 0.5\nillum 7\nmap_Kd -s 1 1 1 -o 0.5 0.5 my texture.png\nbump -bm 0.3 height.png\n"
+      "newmtl Glass\nTf 0.9\nKd xyz 0.95047 1 1.08883\n",
+      "t.mtl");
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_EQ(m[0].name, "Grey");
+  EXPECT_EQ(m[0].kd, Vec3(0.5f));
+  EXPECT_EQ(m[0].ks, (Vec3{0.1f, 0.2f, 0.3f}));
+  EXPECT_EQ(m[0].ke, (Vec3{17.0f, 12.0f, 4.0f}));
+  EXPECT_EQ(m[0].ns, 10.0f);
+  EXPECT_EQ(m[0].ni, 1.5f);
+  EXPECT_EQ(m[0].dissolve, 0.25f);  // d wins over Tr
+  EXPECT_EQ(m[0].illum, 7);
+  EXPECT_EQ(m[0].diffuse_map, "my texture.png");
+  EXPECT_EQ(m[0].bump_map, "height.png");
+  EXPECT_FLOAT_EQ(m[0].bump_multiplier, 0.3f);
+  EXPECT_EQ(m[1].tf, Vec3(0.9f));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(m[1].kd[i], 1.0f, 2e-3f);  // D65 white is RGB white
+}
+
+TEST(MtlParser, BadValuesAreErrorsWithFileAndLine) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"Kd nan", "t.mtl:2: 'Kd' value 'nan' is not a finite number"},
+      {"Kd red green blue", "t.mtl:2: malformed number 'red'"},
+      {"Ke nan", "t.mtl:2: 'Ke' value 'nan' is not a finite number"},
+      {"Ke 3e38", "t.mtl:2: 'Ke' value '3e38' out of range [0, 1e+06]"},
+      {"Kd 1e308", "t.mtl:2: 'Kd' value '1e308' out of range [0, 1]"},
+      {"Kd 1e999", "t.mtl:2: 'Kd' value '1e999' is not a finite number"},
+      {"Kd -0.5", "t.mtl:2: 'Kd' value '-0.5' out of range [0, 1]"},
+      {"Kd 0.5 0.5", "t.mtl:2: 'Kd' needs one value or three, got two"},
+      {"Kd 0.1 0.2 0.3 0.4", "t.mtl:2: 'Kd' has more than three values"},
+      {"Kd", "t.mtl:2: 'Kd' needs a number"},
+      {"Kd spectral a.rfl", "t.mtl:2: 'Kd spectral' is not supported"},
+      {"Ns -1", "t.mtl:2: 'Ns' value '-1' out of range"},
+      {"Ni 1e3", "t.mtl:2: 'Ni' value '1e3' out of range [0, 100]"},
+      {"d 2", "t.mtl:2: 'd' value '2' out of range [0, 1]"},
+      {"illum 2.5", "t.mtl:2: 'illum' takes a whole number from 0 to 10"},
+      {"illum 11", "t.mtl:2: 'illum' value '11' out of range [0, 10]"},
+      {"Ns 1 2", "t.mtl:2: 'Ns' has an extra value '2'"},
+      {"map_Kd", "t.mtl:2: 'map_Kd' needs a file name"},
+      {"map_Kd -clamp", "t.mtl:2: 'map_Kd' option '-clamp' needs a value"},
+  };
+  for (const auto& [line, message] : cases) {
+    SCOPED_TRACE(line);
+    try {
+      parse_mtl(std::string("newmtl m\n") + line + "\n", "t.mtl");
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(parse_mtl("Kd 1 1 1\n", "t.mtl"), InputError);  // before any newmtl
+}
+
+TEST(MtlParser, OneValueIsGreyAndTwoSpacesStillNameTheMaterial) {
+  const Scene s = load_obj_from_string("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n",
+                                       "newmtl  Lamp\nKd 0.5\nKe 2\n", "m.obj");
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[s.tri_material[0]].name, "Lamp");
+  EXPECT_EQ(s.materials[0].kd, Vec3(0.5f));
+  EXPECT_EQ(s.materials[0].ke, Vec3(2.0f));
+  EXPECT_EQ(s.lights.size(), 1u);
+}
+
+TEST_F(Hardening, InputsThatNeverEndStopAtTheirLimit) {
+  fs::create_symlink("/dev/zero", in("zero.mtl"));
+  std::ofstream(in("zero.obj")) << "mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  auto r = test::run_tracer("render " + in("zero.obj") + " -q -o " + in("z.png"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("zero.mtl: larger than 64 MiB, the limit for this input"), std::string::npos) << r.output;
+  {
+    std::ofstream big(in("big.obj"));
+    for (int i = 0; i < 70000; ++i) big << "v 0.000000 0.000000 0.000000\n";
+    big << "f 1 2 3\n";
+  }
+  r = test::run_tracer("render " + in("big.obj") + " -q --max-input-mib 1 -o " + in("z.png"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("big.obj: larger than 1 MiB"), std::string::npos) << r.output;
+  r = test::run_tracer("render " + in("big.obj") + " -q --max-input-mib 0 -o " + in("z.png"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(in("z.png")));
+}
+
+// The header of a PNG that claims 16384 x 16384 texels, and no image data: the size is refused
+// from the header, before anything is decoded.
+std::string png_header(uint32_t width, uint32_t height) {
+  std::string png = "\x89PNG\r\n\x1a\n";
+  const auto be32 = [&](uint32_t v) {
+    for (int s = 24; s >= 0; s -= 8) png += char((v >> s) & 0xff);
+  };
+  be32(13);
+  const size_t crc_from = png.size();
+  png += "IHDR";
+  be32(width);
+  be32(height);
+  png += std::string("\x08\x02\x00\x00\x00", 5);
+  uint32_t crc = 0xffffffffu;  // CRC-32 of type and data, as PNG requires
+  for (size_t i = crc_from; i < png.size(); ++i) {
+    crc ^= uint8_t(png[i]);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  be32(~crc);
+  return png;
+}
+
+TEST_F(Hardening, TextureBombsAreRefusedFromTheirHeader) {
+  std::ofstream(in("bomb.png"), std::ios::binary) << png_header(16384, 16384);
+  try {
+    load_texture(in("bomb.png"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("16384x16384 texels, more than the 67108864 a texture may have"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(in("bomb.mtl")) << "newmtl a\nmap_Kd bomb.png\n";
+  std::ofstream(in("bomb.obj")) << "mtllib bomb.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
+  std::vector<std::string> warnings;
+  const Scene s = load_obj(in("bomb.obj"), [&](const std::string& w) { warnings.push_back(w); });
+  EXPECT_TRUE(s.textures.empty());
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("more than the 67108864 a texture may have"), std::string::npos) << warnings[0];
+  // And the total: two real textures with a cap below their sum.
+  LoadLimits limits;
+  limits.textures.max_total_bytes = 4;  // one 1x1 texture is 3 bytes
+  std::ofstream(in("two.mtl")) << "newmtl a\nmap_Kd s-0001.png\nnewmtl b\nmap_Kd t.ppm\n";
+  std::ofstream(in("t.ppm"), std::ios::binary) << "P6\n1 1\n255\n" << std::string(3, '\x7f');
+  std::ofstream(in("two.obj")) << "mtllib two.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n"
+                               << "usemtl b\nf 1 2 3\n";
+  warnings.clear();
+  const Scene two = load_obj(
+      in("two.obj"), [&](const std::string& w) { warnings.push_back(w); }, nullptr, limits);
+  EXPECT_EQ(two.textures.size(), 1u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("the scene's textures would take more than"), std::string::npos) << warnings[0];
+}
+
+TEST_F(Hardening, TexturesThatAreNoRegularFileSayWhy) {
+  ASSERT_EQ(::mkfifo(in("fifo.png").c_str(), 0644), 0);
+  fs::create_symlink("loop-b.png", in("loop-a.png"));
+  fs::create_symlink("loop-a.png", in("loop-b.png"));
+  EXPECT_THROW(
+      {
+        try {
+          load_texture(in("fifo.png"));
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("not a regular file (a FIFO)"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      InputError);
+  EXPECT_THROW(
+      {
+        try {
+          load_texture(in("loop-a.png"));
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("symbolic links"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      InputError);
+  // Found (not "not found") by the finder, which lists each directory once.
+  FileFinder finder;
+  EXPECT_EQ(finder.find(dir_, "FIFO.PNG"), fs::path(in("fifo.png")));
+  EXPECT_EQ(finder.find(dir_, "loop-a.png"), fs::path(in("loop-a.png")));
+  EXPECT_FALSE(finder.find(dir_, "none.png"));
+}
+
+TEST_F(Hardening, ABlackImageIsNeverSilent) {
+  // The only emitter faces away from the camera, far outside the view.
+  std::ofstream(in("dark.obj")) << "mtllib dark.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 100 100 100\n"
+                                << "v 101 100 100\nv 100 101 100\nf 1 2 3\nusemtl lamp\nf 4 6 5\n";
+  std::ofstream(in("dark.mtl")) << "newmtl lamp\nKe 10 10 10\n";
+  for (const char* integrator : {"path --spp 2", "ao --ambient 0", "whitted --ambient 0"}) {
+    SCOPED_TRACE(integrator);
+    const auto r = test::run_tracer("render " + in("dark.obj") + " -q --width 8 --height 8 --integrator " + integrator +
+                                    " --eye 0,0,3 --look 0,0,0 -o " + in("d.png"));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("the image is black: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--env 1,1,1"), std::string::npos) << r.output;
+  }
+  const auto lit = test::run_tracer("render " + in("tri.obj") + " -q --width 8 --height 8 -o " + in("d.png"));
+  EXPECT_EQ(lit.output.find("the image is black"), std::string::npos) << lit.output;
+}
+
+// --spp anti-aliases ao and whitted too, the same image whatever the threads, scheduler and tiles.
+TEST(AntiAliasing, EveryIntegratorTakesSamplesPerPixelDeterministically) {
+  const std::string dir = test::temp_dir();
+  for (const char* integrator : {"ao", "whitted"}) {
+    SCOPED_TRACE(integrator);
+    const std::string base = std::string("render -q --width 24 --height 20 --integrator ") + integrator;
+    const auto a = test::run_tracer(base + " --spp 4 --threads 1 --sched seq -o " + dir + "/a.ppm");
+    const auto b = test::run_tracer(base + " --spp 4 --threads 2 --sched tbb --tile 7 -o " + dir + "/b.ppm");
+    const auto c = test::run_tracer(base + " --spp 4 --threads 2 --sched async -o " + dir + "/c.ppm");
+    const auto one = test::run_tracer(base + " --spp 1 -o " + dir + "/one.ppm");
+    const auto centre = test::run_tracer(base + " -o " + dir + "/centre.ppm");
+    for (const auto* r : {&a, &b, &c, &one, &centre}) ASSERT_EQ(r->exit_code, 0) << r->output;
+    EXPECT_EQ(slurp(dir + "/a.ppm"), slurp(dir + "/b.ppm"));
+    EXPECT_EQ(slurp(dir + "/a.ppm"), slurp(dir + "/c.ppm"));
+    EXPECT_EQ(slurp(dir + "/one.ppm"), slurp(dir + "/centre.ppm"));  // one sample: the pixel centre
+    EXPECT_NE(slurp(dir + "/a.ppm"), slurp(dir + "/one.ppm"));       // four: edges are smoothed
+  }
+  fs::remove_all(dir);
+}
+
+TEST_F(Hardening, ABrokenViewsFileBesideTheSceneIsAWarning) {
+  std::ofstream(in("views.tsv")) << "scene\tobj\teye\tlook\tup\tfov\tlight\n"
+                                 << "tri\ttri.obj\t0,0,3\t0,0\n";
+  const auto r = test::run_tracer("render " + in("tri.obj") + " --width 8 --height 8 -o " + in("v.png"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("tracer: warning: " + in("views.tsv") + ":2: expected 7 or 8 tab-separated fields"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST_F(Hardening, FrameNamesSortInFrameOrderPastTenThousand) {
+  const auto r = test::run_tracer("render " + in("tri.obj") + " -q --width 2 --height 2 --frames 10001 -o " +
+                                  in("f.ppm") + " --integrator ao --ao 0");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(in("f-00000.ppm")));
+  EXPECT_TRUE(fs::exists(in("f-09999.ppm")));
+  EXPECT_TRUE(fs::exists(in("f-10000.ppm")));
+  EXPECT_LT(std::string("f-09999.ppm"), std::string("f-10000.ppm"));
+}
+
+}  // namespace
+}  // namespace tracer
