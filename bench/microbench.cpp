@@ -13,13 +13,13 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "math/sampling.hpp"
 #include "render/ao.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/views.hpp"
-#include "shade/sampling.hpp"
 
 namespace tracer {
 namespace {

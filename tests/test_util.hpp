@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "film/tone_map.hpp"
 #include "math/ray.hpp"
-#include "render/framebuffer.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer::test {

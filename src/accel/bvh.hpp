@@ -17,6 +17,7 @@
 #include "base/errors.hpp"
 #include "math/aabb.hpp"
 #include "math/ray_packet.hpp"
+#include "parallel/executor.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -107,13 +108,18 @@ struct BvhTopology {
   BvhNodeArray nodes;
   std::vector<uint32_t> ids;  // scene triangle of each leaf slot
 };
-BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options);
+BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
+
+// The executor strategy of a build mode (tasks: oneTBB).
+Strategy strategy_for(BuildMode mode);
 
 class Bvh {
  public:
   static constexpr int kMaxDepth = 96;  // the builder guarantees it; traversal stacks rely on it
 
+  // Builds with the executor `options.mode` names, or the one it is handed.
   Bvh(const Scene& scene, const BvhBuildOptions& options);
+  Bvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;

@@ -5,25 +5,16 @@
 // the partitions are stable, so all builders produce the same tree. Nodes are first written into
 // a scratch array in whatever order threads reach them, then flattened depth-first, which fixes
 // the final layout independently of scheduling.
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <condition_variable>
 #include <cstdlib>
-#include <deque>
-#include <future>
 #include <memory>
-#include <mutex>
-#include <thread>
 #include <utility>
 
 #include <immintrin.h>  // SSE2, part of every x86-64
 
 #include "accel/bvh.hpp"
-#include "parallel/tbb_sync.hpp"
-#include "parallel/thread_count.hpp"
 
 namespace tracer {
 namespace {
@@ -100,7 +91,8 @@ struct Bounds4 {
 
 class BvhBuilder {
  public:
-  BvhBuilder(const Scene& scene, const BvhBuildOptions& options) : options_(options) {
+  BvhBuilder(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+      : options_(options), exec_(exec) {
     options_.bins = std::clamp(options_.bins, 2, kMaxBins);
     options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
     const auto n = static_cast<uint32_t>(scene.size());
@@ -117,21 +109,22 @@ class BvhBuilder {
       }
       return out;
     };
-    if (options_.mode != BuildMode::Tasks || n < kParallelSplit) {
+    if (!exec_.data_parallel() || n < kParallelSplit) {
       count_ = fill(0, n, 0);
       return;
     }
     const uint32_t blocks = (n + kPartitionBlock - 1) / kPartitionBlock;
     std::vector<uint32_t> offsets(blocks + 1, 0);
-    sync_.for_each(blocks, [&](uint32_t k) {
+    exec_.for_each(blocks, [&](size_t k) {
       uint32_t c = 0;
       for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i)
         c += scene.triangles[i].degenerate() ? 0 : 1;
       offsets[k + 1] = c;
     });
     for (uint32_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
-    sync_.for_each(blocks,
-                   [&](uint32_t k) { fill(k * kPartitionBlock, std::min(n, (k + 1) * kPartitionBlock), offsets[k]); });
+    exec_.for_each(blocks, [&](size_t k) {
+      fill(uint32_t(k) * kPartitionBlock, std::min(n, uint32_t(k + 1) * kPartitionBlock), offsets[k]);
+    });
     count_ = offsets[blocks];
   }
 
@@ -139,21 +132,7 @@ class BvhBuilder {
     if (count_ == 0) return;
     nodes_[0] = BuildNode{{}, 0, count_, kInvalidIndex, 0};
     node_count_ = 1;
-    const int threads = resolve_thread_count(options_.threads);
-    switch (options_.mode) {
-      case BuildMode::Seq:
-        build_subtree(0);
-        break;
-      case BuildMode::Async:
-        build_async(0, async_depth_limit(threads));
-        break;
-      case BuildMode::Queue:
-        build_queue(threads);
-        break;
-      case BuildMode::Tasks:
-        build_tasks(0);  // inside the caller's task arena
-        break;
-    }
+    build_node(0);
   }
 
   // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
@@ -171,15 +150,10 @@ class BvhBuilder {
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
     const Output o{out.data(), ids.data(), pair_parent ? pair_parent->data() : nullptr,
                    leaf_of ? leaf_of->data() : nullptr};
-    place(o, 0, 0, 2, options_.mode == BuildMode::Tasks);
+    place(o, 0, 0, 2, exec_.data_parallel());
   }
 
  private:
-  static int async_depth_limit(int threads) {
-    // Enough forks to give every thread a subtree, plus one level for balance.
-    return std::bit_width(static_cast<unsigned>(threads)) + 1;
-  }
-
   // Builds everything below `id` on this thread. The descendants' build nodes go to one block
   // reserved up front (n primitives make at most 2n - 2 of them), so threads building different
   // subtrees never write neighbouring nodes (no false sharing) and take no atomic per node.
@@ -199,72 +173,21 @@ class BvhBuilder {
     finish(id);
   }
 
-  // The study's v1: one std::async per recursive call, but only near the root and for large
-  // subtrees, so it never starts a thread per node.
-  void build_async(uint32_t id, int depth_left) {
-    if (!split(id, false)) return finish(id);
-    const uint32_t left = nodes_[id].left;
-    const BuildNode& l = nodes_[left];
-    if (depth_left > 0 && l.end - l.begin >= kParallelSubtree) {
-      auto right = std::async(std::launch::async, [this, left, depth_left] { build_async(left + 1, depth_left - 1); });
-      build_async(left, depth_left - 1);
-      right.get();
-    } else {
-      build_subtree(left);
-      build_subtree(left + 1);
-    }
-    finish(id);
-  }
-
-  // The study's v2: workers take node jobs from a shared FIFO. The lock covers only push/pop;
-  // idle workers sleep on a condition variable until a job arrives or every job has finished.
-  void build_queue(int threads) {
-    std::mutex mutex;
-    std::condition_variable cv;
-    std::deque<uint32_t> jobs{0};
-    size_t unfinished = 1;  // queued or running
-    const auto worker = [&] {
-      for (;;) {
-        uint32_t id;
-        {
-          std::unique_lock lock(mutex);
-          cv.wait(lock, [&] { return !jobs.empty() || unfinished == 0; });
-          if (jobs.empty()) return;
-          id = jobs.front();
-          jobs.pop_front();
-        }
-        const BuildNode& n = nodes_[id];
-        if (n.end - n.begin < kParallelSubtree) {
-          build_subtree(id);
-        } else if (split(id, false)) {
-          const uint32_t left = nodes_[id].left;
-          std::lock_guard lock(mutex);
-          jobs.push_back(left);
-          jobs.push_back(left + 1);
-          unfinished += 2;
-          cv.notify_all();
-        }
-        std::lock_guard lock(mutex);
-        if (--unfinished == 0) cv.notify_all();
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
-    for (std::thread& t : pool) t.join();
-  }
-
-  // oneTBB: fork-join over subtrees, and data-parallel bounds, binning and partitioning for the
-  // few large nodes near the root, where there are too few subtrees to go round.
-  void build_tasks(uint32_t id) {
+  // Large subtrees go to the executor's forks (the study's async and queue strategies, or oneTBB
+  // tasks); small ones, and every subtree under an executor that does not fork, are built by one
+  // thread. Only oneTBB also splits one node's bounds, binning and partitioning, for the few
+  // large nodes near the root where there are too few subtrees to go round. The tree is the same
+  // under every executor: only which thread builds which subtree differs.
+  void build_node(uint32_t id) {
     const BuildNode& n = nodes_[id];
     const uint32_t size = n.end - n.begin;
-    if (size < kParallelSubtree) {
+    if (size < kParallelSubtree || !exec_.forks()) {
       build_subtree(id);
       return;
     }
-    if (!split(id, size >= kParallelSplit)) return finish(id);
+    if (!split(id, exec_.data_parallel() && size >= kParallelSplit)) return finish(id);
     const uint32_t left = nodes_[id].left;
-    sync_.fork_join([&] { build_tasks(left); }, [&] { build_tasks(left + 1); });
+    exec_.fork_join([&] { build_node(left); }, [&] { build_node(left + 1); });
     finish(id);
   }
 
@@ -310,7 +233,7 @@ class BvhBuilder {
     const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
     const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
     if (parallel && n.end - n.begin >= kParallelSubtree) {
-      sync_.fork_join(place_left, place_right);
+      exec_.fork_join(place_left, place_right);
     } else {
       place_left();
       place_right();
@@ -320,7 +243,7 @@ class BvhBuilder {
   template <class Body, class T>
   T reduce_range(uint32_t begin, uint32_t end, bool parallel, T init, const Body& body) const {
     if (!parallel) return body(begin, end, init);
-    return sync_.reduce(begin, end, kPartitionBlock, init, body);
+    return exec_.reduce(begin, end, kPartitionBlock, init, body);
   }
 
   // Decides node `id`: a leaf (false) or two children (true), placed at *cursor (which advances)
@@ -615,7 +538,7 @@ class BvhBuilder {
     }
     const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
     std::vector<uint32_t> left_counts(blocks + 1, 0);
-    sync_.for_each(blocks, [&](uint32_t k) {
+    exec_.for_each(blocks, [&](size_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       uint32_t c = 0;
       for (uint32_t i = b; i < e; ++i) c += pred(src[i]) ? 1 : 0;
@@ -623,7 +546,7 @@ class BvhBuilder {
     });
     for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
     std::vector<SideCentroids> block(blocks);
-    sync_.for_each(blocks, [&](uint32_t k) {
+    exec_.for_each(blocks, [&](size_t k) {
       const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
       run(b, e, begin + left_counts[k], mid + (b - begin) - left_counts[k], block[k]);  // rights before this block
     });
@@ -641,41 +564,42 @@ class BvhBuilder {
   uint32_t count_ = 0;
   std::unique_ptr<BuildNode[], FreeNodes> nodes_;
   std::atomic<uint32_t> node_count_{0};
-  TbbSync sync_;  // oneTBB's parallel calls, with edges ThreadSanitizer sees
+  const Executor& exec_;
 };
 
 }  // namespace
 
-namespace {
-
-// Runs `construct` where the build's parallel pieces run: a oneTBB arena of the build's thread
-// count for the tasks build (setup included), the calling thread otherwise.
-template <class F>
-void in_build_arena(const BvhBuildOptions& options, F&& construct) {
-  if (options.mode == BuildMode::Tasks) {
-    tbb::task_arena arena(resolve_thread_count(options.threads));
-    arena.execute(construct);
-  } else {
-    construct();
+Strategy strategy_for(BuildMode mode) {
+  switch (mode) {
+    case BuildMode::Seq:
+      return Strategy::Seq;
+    case BuildMode::Async:
+      return Strategy::Async;
+    case BuildMode::Queue:
+      return Strategy::Queue;
+    case BuildMode::Tasks:
+      break;
   }
-  throw_if_cancelled(options.cancel);
+  return Strategy::Tbb;
 }
 
-}  // namespace
-
-BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options) {
+BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options, const Executor& exec) {
   BvhTopology t;
-  in_build_arena(options, [&] {
-    BvhBuilder builder(scene, options);
+  exec.run([&] {
+    BvhBuilder builder(scene, options, exec);
     builder.build();
     builder.flatten(t.nodes, t.ids, nullptr, nullptr);
   });
+  throw_if_cancelled(options.cancel);
   return t;
 }
 
-Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), options_(options) {
-  in_build_arena(options, [&] {
-    BvhBuilder builder(scene, options);
+Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options)
+    : Bvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
+
+Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec) : scene_(&scene), options_(options) {
+  exec.run([&] {
+    BvhBuilder builder(scene, options, exec);
     builder.build();
     leaf_of_.assign(scene.size(), kInvalidIndex);
     builder.flatten(nodes_, ids_, &pair_parent_, &leaf_of_);
@@ -683,15 +607,15 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : scene_(&scene), o
     const auto copy = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];
     };
-    if (options.mode == BuildMode::Tasks && ids_.size() >= kParallelSplit) {
-      const uint32_t blocks = uint32_t((ids_.size() + kPartitionBlock - 1) / kPartitionBlock);
-      TbbSync().for_each(blocks, [&](uint32_t k) {
-        copy(size_t(k) * kPartitionBlock, std::min(ids_.size(), size_t(k + 1) * kPartitionBlock));
-      });
+    if (exec.data_parallel() && ids_.size() >= kParallelSplit) {
+      const size_t blocks = (ids_.size() + kPartitionBlock - 1) / kPartitionBlock;
+      exec.for_each(blocks,
+                    [&](size_t k) { copy(k * kPartitionBlock, std::min(ids_.size(), (k + 1) * kPartitionBlock)); });
     } else {
       copy(0, ids_.size());
     }
   });
+  throw_if_cancelled(options.cancel);
 }
 
 }  // namespace tracer

@@ -49,6 +49,7 @@ class WideBvh {
   // Builds the binary SAH tree with `options` (leaves of up to eight triangles: one pack), then
   // collapses it.
   WideBvh(const Scene& scene, const BvhBuildOptions& options);
+  WideBvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;

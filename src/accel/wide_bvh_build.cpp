@@ -3,11 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include <tbb/task_arena.h>
-
 #include "accel/wide_bvh.hpp"
-#include "parallel/tbb_sync.hpp"
-#include "parallel/thread_count.hpp"
 
 namespace tracer {
 
@@ -97,7 +93,7 @@ class Collapser {
   }
 
  public:
-  void fill_packs(bool parallel) {
+  void fill_packs(const Executor& exec) {
     packs_.resize(pack_runs_.size());
     const auto fill = [&](size_t begin, size_t end) {
       for (size_t k = begin; k < end; ++k)
@@ -105,9 +101,8 @@ class Collapser {
     };
     constexpr size_t kBlock = 1024;
     const auto blocks = uint32_t((pack_runs_.size() + kBlock - 1) / kBlock);
-    if (!parallel || blocks < 2) return fill(0, pack_runs_.size());
-    TbbSync().for_each(
-        blocks, [&](uint32_t b) { fill(size_t(b) * kBlock, std::min(pack_runs_.size(), size_t(b + 1) * kBlock)); });
+    if (!exec.data_parallel() || blocks < 2) return fill(0, pack_runs_.size());
+    exec.for_each(blocks, [&](size_t b) { fill(b * kBlock, std::min(pack_runs_.size(), (b + 1) * kBlock)); });
   }
 
  private:
@@ -124,20 +119,18 @@ class Collapser {
 
 }  // namespace
 
-WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in) : scene_(&scene) {
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
+    : WideBvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
+
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec) : scene_(&scene) {
   BvhBuildOptions options = options_in;
   options.max_leaf = std::min(options.max_leaf, kWideWidth);
-  const BvhTopology binary = build_bvh_topology(scene, options);
+  const BvhTopology binary = build_bvh_topology(scene, options, exec);
   if (binary.nodes.empty()) return;
   nodes_.reserve(binary.nodes.size() / 4 + 1);
   Collapser collapser(binary, scene, nodes_, packs_);
   collapser.collapse(0);
-  if (options.mode == BuildMode::Tasks) {
-    tbb::task_arena arena(resolve_thread_count(options.threads));
-    arena.execute([&] { collapser.fill_packs(true); });
-  } else {
-    collapser.fill_packs(false);
-  }
+  exec.run([&] { collapser.fill_packs(exec); });
   bounds_ = Aabb{binary.nodes[0].lo, binary.nodes[0].hi};
   // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
   node_place_.assign(nodes_.size(), kInvalidIndex);

@@ -12,14 +12,18 @@
 
 #include "base/errors.hpp"
 #include "cli/bench.hpp"
-#include "cli/progress.hpp"
-#include "cli/render_args.hpp"
-#include "cli/render_stats.hpp"
-#include "cli/signals.hpp"
+#include "driver/progress.hpp"
+#include "driver/render_args.hpp"
+#include "driver/render_driver.hpp"
+#include "driver/render_stats.hpp"
+#include "driver/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
 
 namespace tracer::cli {
+
+using namespace driver;  // the flags, signals and statistics both binaries share
+
 namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -55,55 +59,38 @@ int cmd_render(const RenderArgs& args) {
   RenderControl control;
   control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
-  int checkpoints = 0;
   const uint64_t work =
       uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
   ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
-  bool warned_black = false;
-  // Each frame of --frames N: the camera orbits the look point; one output file per frame.
-  for (int frame = 0; frame < args.frames; ++frame) {
-    const std::string output = frame_output(args.output, frame, args.frames);
-    Framebuffer fb(settings.width, settings.height);
-    const Camera cam(frame_camera(camera, frame, args.frames, args.orbit), settings.width, settings.height);
-    RenderContext ctx{&scene, cam, settings, &fb};
-    const auto write_image = [&] { write_render(output, fb, settings.exposure, exr_pixel_for(args)); };
-    auto last_write = std::chrono::steady_clock::now();
-    const auto checkpoint = [&](uint32_t samples) {
-      if (!args.checkpoint || samples >= uint32_t(settings.spp)) return;
-      if (ms_since(last_write) < *args.checkpoint * 1e3) return;
-      write_image();
-      ++checkpoints;
-      last_write = std::chrono::steady_clock::now();
-    };
-    if (!render_passes(accel, ctx, sched, control, checkpoint)) {
-      progress.stop();
-      // A path render stopped after its first pass is a complete image, only noisier.
-      const uint32_t samples = fb.min_samples();
-      if (samples > 0) {
-        write_image();
-        std::cerr << "tracer: " << stop_signal_name() << " after " << samples << " of " << settings.spp
-                  << " samples per pixel; image written to " << output << "\n";
-      } else if (args.save_partial && control.pixels_done.load() > 0) {
-        write_image();
-        std::cerr << "tracer: " << stop_signal_name() << "; partial image written to " << output << "\n";
-      } else {
-        std::cerr << "tracer: " << stop_signal_name() << (args.save_partial ? " before any tile finished" : "")
-                  << "; no image written\n";
-      }
-      return exit_code_for_stop();
+  // Every pass a round of its own: checkpoints, and a complete image after the first on Ctrl-C.
+  const auto render_round = [&](const RenderContext& ctx, const std::vector<SampleRange>& round) {
+    RenderContext c = ctx;
+    for (const SampleRange& pass : round) {
+      c.samples = pass;
+      if (!render_image(accel, c, sched, control)) return false;
     }
-    write_image();
-    if (!warned_black && looks_black(fb, settings.exposure)) {
-      std::cerr << "tracer: warning: " << output << ": " << black_image_warning(settings, scene) << "\n";
-      warned_black = true;
+    return true;
+  };
+  const FrameSequence frames{args.output,     args.frames,         args.orbit,
+                             args.checkpoint, exr_pixel_for(args), args.save_partial};
+  const DriveResult r = drive_render(scene, camera, settings, frames, true, true, cancel, render_round,
+                                     [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
+  if (r.stopped) {
+    progress.stop();
+    std::cerr << "tracer: " << stop_signal_name();
+    if (r.stopped_after_write) {
+      std::cerr << " after the render finished; image written to " << r.output << "\n";
+    } else if (r.samples > 0) {
+      std::cerr << " after " << r.samples << " of " << settings.spp << " samples per pixel; image written to "
+                << r.output << "\n";
+    } else if (r.wrote_partial) {
+      std::cerr << "; partial image written to " << r.output << "\n";
+    } else {
+      std::cerr << (args.save_partial ? " before any tile finished" : "") << "; no image written\n";
     }
-    if (stop_signal() != 0) {  // arrived during the write, which is never torn
-      progress.stop();
-      std::cerr << "tracer: " << stop_signal_name() << " after the render finished; image written to " << output
-                << "\n";
-      return exit_code_for_stop();
-    }
+    return exit_code_for_stop();
   }
+  const int checkpoints = r.checkpoints;
   progress.stop();
   const double render_ms = ms_since(t_render);
   nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
@@ -146,6 +133,7 @@ int cmd_compare(const std::string& a, const std::string& b) {
 int main(int argc, char** argv) {
   using namespace tracer;
   using namespace tracer::cli;
+  using namespace tracer::driver;
   CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ scenes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "tracer 0.1.0");

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "base/enum_names.hpp"
-#include "render/framebuffer.hpp"
+#include "film/framebuffer.hpp"
 
 namespace tracer {
 

@@ -15,7 +15,7 @@
 #include <filesystem>
 
 #include "base/errors.hpp"
-#include "io/read_input.hpp"
+#include "base/read_input.hpp"
 
 namespace tracer {
 

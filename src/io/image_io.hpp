@@ -5,8 +5,8 @@
 #include <string>
 #include <string_view>
 
+#include "film/tone_map.hpp"
 #include "io/exr_io.hpp"
-#include "render/framebuffer.hpp"
 
 namespace tracer {
 

@@ -21,10 +21,11 @@
 #include <vector>
 
 #include "base/errors.hpp"
-#include "cli/progress.hpp"
-#include "cli/render_args.hpp"
-#include "cli/render_stats.hpp"
-#include "cli/signals.hpp"
+#include "driver/progress.hpp"
+#include "driver/render_args.hpp"
+#include "driver/render_driver.hpp"
+#include "driver/render_stats.hpp"
+#include "driver/signals.hpp"
 #include "io/image_io.hpp"
 #include "mpi/mpi_session.hpp"
 #include "mpi/tile_server.hpp"
@@ -60,21 +61,21 @@ struct Setup {
   double load_ms = 0;
 };
 
-Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
+Setup set_up(const driver::RenderArgs& args, const MpiSession& session) {
   Setup s;
   try {
-    cli::validate(args);
-    if (session.root()) cli::check_outputs(args);
-    WideBvh::force_simd_target(cli::simd_target_for(args));
+    driver::validate(args);
+    if (session.root()) driver::check_outputs(args);
+    WideBvh::force_simd_target(driver::simd_target_for(args));
     const auto t0 = Clock::now();
-    s.scene.emplace(cli::load_scene(args.scene, args.quiet || !session.root()));
+    s.scene.emplace(driver::load_scene(args.scene, args.quiet || !session.root()));
     s.load_ms = ms_since(t0);
-    if (session.root()) cli::check_outputs_against_inputs(args);
-    s.camera = cli::camera_for(*s.scene, args);
+    if (session.root()) driver::check_outputs_against_inputs(args);
+    s.camera = driver::camera_for(*s.scene, args);
     std::string note;
-    s.settings = cli::settings_for(args, *s.scene, note);
+    s.settings = driver::settings_for(args, *s.scene, note);
     if (!note.empty() && !args.quiet && session.root()) say("tracer-mpi: note: " + note);
-    s.sched = cli::sched_options_for(args);
+    s.sched = driver::sched_options_for(args);
     const int usable = resolve_thread_count(0);
     const int machine = int(std::thread::hardware_concurrency());
     if (args.threads && *args.threads > usable && usable < machine) {
@@ -88,7 +89,7 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
                                std::to_string(*args.threads) + ")\n";
       std::fputs(line.c_str(), stderr);  // one write: the ranks' lines do not interleave
     }
-    AccelOptions accel_options = cli::accel_options_for(args);
+    AccelOptions accel_options = driver::accel_options_for(args);
     s.accel.emplace(build_accelerator(*s.scene, accel_options));
   } catch (const UsageError& e) {
     s.exit_code = 2;
@@ -103,17 +104,10 @@ Setup set_up(const cli::RenderArgs& args, const MpiSession& session) {
   return s;
 }
 
-// The passes each round of tile distribution covers. With --checkpoint, one round per pass, so
-// rank 0 has every pass complete in turn; without, one round of every pass: each tile is
-// rendered whole (its passes in order, adding up exactly as one process adds them) and crosses
-// the network once, so rank 0 adds each pixel once instead of once per pass.
-std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool progressive) {
-  const std::vector<SampleRange> passes = sample_passes(settings);
-  if (!progressive) return {passes};
-  std::vector<std::vector<SampleRange>> rounds;
-  for (const SampleRange& p : passes) rounds.push_back({p});
-  return rounds;
-}
+// The passes each round of tile distribution covers (driver::rounds_of): with --checkpoint, one
+// round per pass, so rank 0 has every pass complete in turn; without, one round of every pass:
+// each tile is rendered whole (its passes in order, adding up exactly as one process adds them)
+// and crosses the network once, so rank 0 adds each pixel once instead of once per pass.
 
 // Renders the passes of `round` of one tile, in order, into `fb` (rank 0's image, or a window for
 // the tile).
@@ -136,8 +130,8 @@ constexpr const char* kStopMessage =
     "tracer-mpi: rank 0 stopped by a signal (mpirun sends it on Ctrl-C and when another rank fails: see its "
     "message); no image written\n";
 
-int run(const cli::RenderArgs& args, MpiSession& session) {
-  cli::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
+int run(const driver::RenderArgs& args, MpiSession& session) {
+  driver::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
   const ThreadLimit thread_limit(args.threads.value_or(0));
   Setup setup = set_up(args, session);
 
@@ -176,7 +170,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
   if (verdict != 0) {
     // The first rank to exit non-zero makes mpirun stop the others with SIGTERM: rank 0 has said
     // what is wrong, so that signal needs no second message.
-    cli::install_immediate_stop_handlers(nullptr);
+    driver::install_immediate_stop_handlers(nullptr);
     return verdict;
   }
 
@@ -193,9 +187,8 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
   AtomicRayCounts counts;
   std::atomic<uint64_t> pixels_done{0}, rays_done{0};
   std::vector<uint64_t> tiles_per_rank(size_t(session.size()), 0);
-  int checkpoints = 0;
   const auto t_render = Clock::now();
-  std::optional<cli::ProgressBar> progress;
+  std::optional<driver::ProgressBar> progress;
   if (session.root()) {
     const uint64_t work =
         uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
@@ -203,87 +196,75 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
   }
   std::mutex report_mutex;
   uint32_t round_serial = 0;  // rounds over all frames, for their messages' tags
-  for (int frame = 0; frame < args.frames; ++frame) {
-    const std::string output = cli::frame_output(args.output, frame, args.frames);
-    std::optional<Framebuffer> fb;
-    if (session.root()) fb.emplace(settings.width, settings.height);
-    const Camera camera(cli::frame_camera(setup.camera, frame, args.frames, args.orbit), settings.width,
-                        settings.height);
-    RenderContext ctx{&scene, camera, settings, nullptr};
-    auto last_write = Clock::now();
-    for (const std::vector<SampleRange>& round : rounds_of(settings, args.checkpoint.has_value())) {
-      ++round_serial;
-      const uint32_t first = round.front().first, samples = round.back().first + round.back().count - first;
-      const auto count = [&](const RayCounts& c, const Tile& t) {
-        counts.add(c);
-        rays_done.fetch_add(c.total(), std::memory_order_relaxed);
-        pixels_done.fetch_add(uint64_t(t.pixel_count()) * samples, std::memory_order_relaxed);
-      };
-      if (session.root()) {
-        TileServer server(tiles, remote_threads, session.size(), round_serial);
-        std::exception_ptr own_failure;
-        std::thread own([&] {
-          try {
-            parallel_pull(
-                threads, [&] { return server.take(); },
-                [&](uint32_t i) { count(render_one(accel, ctx, round, *fb, tiles[i]), tiles[i]); });
-          } catch (...) {
-            own_failure = std::current_exception();
-          }
-        });
-        try {
-          server.serve(*fb, samples);
-        } catch (const RankFailed& e) {
-          if (progress) progress->stop();
-          say("tracer-mpi: error: rank " + std::to_string(e.rank) + " of " + std::to_string(session.size()) + ": " +
-              e.what() + "; no image written");
-          MPI_Abort(MPI_COMM_WORLD, 1);
-        }
-        own.join();
-        if (own_failure) std::rethrow_exception(own_failure);  // main() reports it and aborts the job
-        server_ms += server.busy_ms();
-        served += server.messages();
-        const std::vector<uint64_t> given = server.tiles_per_rank();
-        for (size_t r = 0; r < given.size(); ++r) tiles_per_rank[r] += given[r];
-        const uint32_t done = first + samples;
-        if (args.checkpoint && done < uint32_t(settings.spp) && ms_since(last_write) >= *args.checkpoint * 1e3) {
-          write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
-          ++checkpoints;
-          last_write = Clock::now();
-        }
-      } else {
-        TileClient client(tiles, round_serial);
-        try {
-          // Each thread renders its tiles into windows of its own and sends them back; its next
-          // request is already in flight while it renders.
-          std::atomic<int> thread_ids{0};
-          parallel_run(threads, [&] {
-            TileClient::Worker worker(client, thread_ids.fetch_add(1));
-            std::optional<uint32_t> finished;
-            std::unique_ptr<Framebuffer> result;
-            double idle = 0;
-            while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
-              const Tile& t = tiles[*next];
-              result = std::make_unique<Framebuffer>(t);
-              count(render_one(accel, ctx, round, *result, t), t);
-              finished = *next;
-            }
-            std::lock_guard lock(report_mutex);
-            mine.idle_ms += idle;
-          });
-        } catch (const std::exception& e) {
-          TileClient::report_failure(e.what());
-          for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));  // rank 0 aborts the job
-        }
-      }
-    }
+  const auto render_round = [&](const RenderContext& ctx, const std::vector<SampleRange>& round) {
+    ++round_serial;
+    const uint32_t first = round.front().first, samples = round.back().first + round.back().count - first;
+    const auto count = [&](const RayCounts& c, const Tile& t) {
+      counts.add(c);
+      rays_done.fetch_add(c.total(), std::memory_order_relaxed);
+      pixels_done.fetch_add(uint64_t(t.pixel_count()) * samples, std::memory_order_relaxed);
+    };
     if (session.root()) {
-      write_render(output, *fb, settings.exposure, cli::exr_pixel_for(args));
-      if (frame == 0 && looks_black(*fb, settings.exposure)) {
-        say("tracer-mpi: warning: " + output + ": " + cli::black_image_warning(settings, scene));
+      Framebuffer& fb = *ctx.framebuffer;
+      TileServer server(tiles, remote_threads, session.size(), round_serial);
+      std::exception_ptr own_failure;
+      std::thread own([&] {
+        try {
+          parallel_pull(
+              threads, [&] { return server.take(); },
+              [&](uint32_t i) { count(render_one(accel, ctx, round, fb, tiles[i]), tiles[i]); });
+        } catch (...) {
+          own_failure = std::current_exception();
+        }
+      });
+      try {
+        server.serve(fb, samples);
+      } catch (const RankFailed& e) {
+        if (progress) progress->stop();
+        say("tracer-mpi: error: rank " + std::to_string(e.rank) + " of " + std::to_string(session.size()) + ": " +
+            e.what() + "; no image written");
+        MPI_Abort(MPI_COMM_WORLD, 1);
       }
+      own.join();
+      if (own_failure) std::rethrow_exception(own_failure);  // main() reports it and aborts the job
+      server_ms += server.busy_ms();
+      served += server.messages();
+      const std::vector<uint64_t> given = server.tiles_per_rank();
+      for (size_t r = 0; r < given.size(); ++r) tiles_per_rank[r] += given[r];
+      return true;
     }
-  }
+    TileClient client(tiles, round_serial);
+    try {
+      // Each thread renders its tiles into windows of its own and sends them back; its next
+      // request is already in flight while it renders.
+      std::atomic<int> thread_ids{0};
+      parallel_run(threads, [&] {
+        TileClient::Worker worker(client, thread_ids.fetch_add(1));
+        std::optional<uint32_t> finished;
+        std::unique_ptr<Framebuffer> result;
+        double idle = 0;
+        while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
+          const Tile& t = tiles[*next];
+          result = std::make_unique<Framebuffer>(t);
+          count(render_one(accel, ctx, round, *result, t), t);
+          finished = *next;
+        }
+        std::lock_guard lock(report_mutex);
+        mine.idle_ms += idle;
+      });
+    } catch (const std::exception& e) {
+      TileClient::report_failure(e.what());
+      for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));  // rank 0 aborts the job
+    }
+    return true;
+  };
+  // Signals end a rank at once (install_immediate_stop_handlers): no round is ever stopped.
+  const driver::FrameSequence frames{args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args),
+                                     false};
+  const driver::DriveResult driven =
+      driver::drive_render(scene, setup.camera, settings, frames, session.root(), args.checkpoint.has_value(), nullptr,
+                           render_round, [](const std::string& w) { say("tracer-mpi: warning: " + w); });
+  const int checkpoints = driven.checkpoints;
   if (progress) progress->stop();
   mine.render_ms = ms_since(t_render);
   mine.rays = counts.load().total();
@@ -302,7 +283,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
   const std::vector<uint64_t> render_us = session.all_gather(uint64_t(mine.render_ms * 1e3));
   if (session.root()) {
     nlohmann::json stats =
-        cli::render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, mine.render_ms, total);
+        driver::render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, mine.render_ms, total);
     uint64_t all_rays = 0;
     nlohmann::json ranks = nlohmann::json::array();
     for (int r = 0; r < session.size(); ++r) {
@@ -325,7 +306,7 @@ int run(const cli::RenderArgs& args, MpiSession& session) {
     stats["rank0_messages"] = served;
     stats["rank0_us_per_message"] = served > 0 ? server_ms * 1e3 / double(served) : 0.0;
     if (args.stats) {
-      cli::print_stats(stats, accel);
+      driver::print_stats(stats, accel);
       std::printf("rank 0       %.1f ms on %llu messages (%.1f us each)\n", server_ms, (unsigned long long)served,
                   served > 0 ? server_ms * 1e3 / double(served) : 0.0);
       for (const auto& r : ranks) {
@@ -353,9 +334,9 @@ int main(int argc, char** argv) {
   }
   CLI::App app{"tracer-mpi: tracer render over the ranks of an Open MPI job (mpirun -np N tracer-mpi render ...)"};
   app.require_subcommand(1);
-  cli::RenderArgs args;
+  driver::RenderArgs args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image, on every rank");
-  cli::add_render_options(*render, args);
+  driver::add_render_options(*render, args);
   render->add_option("-o,--output", args.output, "output image (written by rank 0)")->capture_default_str();
   render->add_flag("--stats", args.stats, "print timings, ray counts and each rank's tiles, rays and idle time");
   render->add_option("--stats-json", args.stats_json, "write the statistics as JSON to this file (rank 0)");

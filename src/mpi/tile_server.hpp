@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "film/framebuffer.hpp"
 #include "parallel/tiles.hpp"
-#include "render/framebuffer.hpp"
 
 namespace tracer::mpi {
 

@@ -1,30 +1,21 @@
-// Parallel loops over the tiles of an image, in the five ways the study compares: the strategy
-// alone, knowing nothing of rays or colours (pbrt-v4's ParallelFor2D is the model). The render
+// Parallel loops over the tiles of an image, in the five ways the study compares (the executor's
+// strategies), knowing nothing of rays or colours (pbrt-v4's ParallelFor2D is the model). The render
 // loop, the tests and any distributed driver hand their per-tile work to parallel_for_tiles().
 #pragma once
 
 #include <functional>
 
-#include "base/enum_names.hpp"
 #include "base/errors.hpp"
+#include "parallel/executor.hpp"
 #include "parallel/thread_count.hpp"
 #include "parallel/tiles.hpp"
 
 namespace tracer {
 
-enum class SchedKind {
-  Seq,     // one thread, row by row
-  Async,   // the study's: one std::async(std::launch::async) per image row
-  Queue,   // the study's: N threads popping row blocks from a mutex-guarded LIFO vector
-  Atomic,  // lock-free: N threads claiming square tiles with one fetch_add each
-  Tbb,     // oneTBB parallel_for over square tiles, work stealing (the default)
-};
-
-inline constexpr EnumName<SchedKind> kSchedKindNames[] = {{SchedKind::Seq, "seq"},
-                                                          {SchedKind::Async, "async"},
-                                                          {SchedKind::Queue, "queue"},
-                                                          {SchedKind::Atomic, "atomic"},
-                                                          {SchedKind::Tbb, "tbb"}};
+// The tile schedulers are the executor's strategies: seq and async hand out image rows, queue
+// row blocks of `block` pixels, atomic and tbb `tile`-edged squares.
+using SchedKind = Strategy;
+inline constexpr const auto& kSchedKindNames = kStrategyNames;
 
 struct SchedOptions {
   SchedKind kind = SchedKind::Tbb;

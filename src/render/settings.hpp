@@ -6,8 +6,8 @@
 #include <cstdint>
 
 #include "base/enum_names.hpp"
+#include "film/framebuffer.hpp"
 #include "math/ray.hpp"
-#include "render/framebuffer.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene.hpp"
 

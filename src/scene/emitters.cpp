@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "math/sampling.hpp"
 #include "scene/scene.hpp"
-#include "shade/sampling.hpp"
 
 namespace tracer {
 

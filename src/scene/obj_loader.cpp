@@ -19,8 +19,8 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "base/read_input.hpp"
 #include "base/text.hpp"
-#include "io/read_input.hpp"
 #include "scene/mtl_parser.hpp"
 #include "scene/texture.hpp"
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "base/errors.hpp"
-#include "io/read_input.hpp"
+#include "base/read_input.hpp"
 #include "scene/scene.hpp"
 #include "scene/texture.hpp"
 

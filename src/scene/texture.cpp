@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "base/errors.hpp"
-#include "io/read_input.hpp"
+#include "base/read_input.hpp"
 
 namespace tracer {
 

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "base/errors.hpp"
+#include "base/read_input.hpp"
 #include "base/text.hpp"
-#include "io/read_input.hpp"
 
 namespace tracer {
 namespace {

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "math/sampling.hpp"
 #include "shade/microfacet.hpp"
 #include "shade/optics.hpp"
-#include "shade/sampling.hpp"
 
 namespace tracer {
 

@@ -45,6 +45,8 @@ class Framebuffer {
   }
   // Fewest samples of any pixel: 0 while some pixel has none.
   uint32_t min_samples() const;
+  // Most samples of any pixel: 0 while no pixel has one.
+  uint32_t max_samples() const;
   // Raw sums by pixel index (row-major), for sending a window's pixels to another rank.
   const Vec3* sums() const { return sum_.data(); }
 
@@ -55,18 +57,5 @@ class Framebuffer {
   std::vector<Vec3> sum_;
   std::vector<uint32_t> samples_;
 };
-
-// 8-bit RGB, rows top to bottom.
-struct Image8 {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgb;
-};
-
-// Exponential tone map 1 - exp(-exposure * L) of each pixel's radiance, then the sRGB transfer
-// curve, rounded to 8 bits.
-Image8 tonemap(const Framebuffer& fb, float exposure);
-
-// Whether tonemap(fb, exposure) is black in every pixel: a render a user must be told about.
-bool looks_black(const Framebuffer& fb, float exposure);
 
 }  // namespace tracer

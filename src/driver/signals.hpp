@@ -6,7 +6,7 @@
 
 #include <atomic>
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 void install_stop_handlers();
 // For a process that cannot stop cleanly on its own (a rank of an MPI job, whose peers the
@@ -19,4 +19,4 @@ int stop_signal();               // the first signal received, 0 if none
 int exit_code_for_stop();        // 128 + stop_signal()
 const char* stop_signal_name();  // "interrupted", "terminated", "hung up"
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

@@ -1,4 +1,4 @@
-#include "cli/render_args.hpp"
+#include "driver/render_args.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,14 +8,14 @@
 #include <numbers>
 
 #include "base/errors.hpp"
-#include "cli/parse.hpp"
+#include "driver/parse.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/views.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 namespace fs = std::filesystem;
 
@@ -366,4 +366,4 @@ SimdTarget simd_target_for(const RenderArgs& a) {
   return parse_name<SimdTarget>(kSimdTargetNames, a.simd_target, "--simd-target", "target");
 }
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

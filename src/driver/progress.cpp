@@ -1,10 +1,10 @@
-#include "cli/progress.hpp"
+#include "driver/progress.hpp"
 
 #include <unistd.h>
 
 #include <cstdio>
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 ProgressBar::ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels,
                          const std::atomic<uint64_t>& rays)
@@ -43,4 +43,4 @@ void ProgressBar::run() {
   if (drawn_) std::fprintf(stderr, "\r%90s\r", "");  // clear the line
 }
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

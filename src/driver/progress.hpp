@@ -9,7 +9,7 @@
 #include <mutex>
 #include <thread>
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 class ProgressBar {
  public:
@@ -30,4 +30,4 @@ class ProgressBar {
   std::thread thread_;
 };
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "accel/accelerator.hpp"
-#include "cli/render_args.hpp"
+#include "driver/render_args.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
@@ -16,4 +16,4 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 // Prints `j` (from render_stats()) as the --stats text.
 void print_stats(const nlohmann::json& j, const Accelerator& accel);
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

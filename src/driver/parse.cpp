@@ -1,4 +1,4 @@
-#include "cli/parse.hpp"
+#include "driver/parse.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "base/errors.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text) {
   double v[3];
@@ -89,4 +89,4 @@ void check_range_real(const std::string& flag, double value, double lo, double h
   }
 }
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

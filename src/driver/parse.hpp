@@ -7,7 +7,7 @@
 
 #include "math/vec.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text);
 // "WxH", each 1-16384.
@@ -19,4 +19,4 @@ Vec3 parse_point(const std::string& flag, const std::string& text);
 void check_range(const std::string& flag, long long value, long long lo, long long hi);
 void check_range_real(const std::string& flag, double value, double lo, double hi, bool lo_open = false);
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

@@ -15,7 +15,7 @@
 #include "scene/obj_loader.hpp"
 #include "scene/scene.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 struct SceneArgs {
   std::string scene;  // empty: the built-in Cornell box
@@ -97,4 +97,4 @@ ExrPixel exr_pixel_for(const RenderArgs& args);
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

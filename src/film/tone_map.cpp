@@ -1,4 +1,4 @@
-#include "render/framebuffer.hpp"
+#include "film/tone_map.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,12 +15,6 @@ uint8_t encode(float linear, float exposure) {
 }
 
 }  // namespace
-
-uint32_t Framebuffer::min_samples() const {
-  uint32_t m = UINT32_MAX;
-  for (uint32_t n : samples_) m = std::min(m, n);
-  return samples_.empty() ? 0u : m;
-}
 
 Image8 tonemap(const Framebuffer& fb, float exposure) {
   Image8 img;

@@ -1,4 +1,4 @@
-#include "io/read_input.hpp"
+#include "base/read_input.hpp"
 
 #include <fcntl.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "cli/signals.hpp"
+#include "driver/signals.hpp"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 
 #include "io/image_io.hpp"
 
-namespace tracer::cli {
+namespace tracer::driver {
 namespace {
 
 std::atomic<bool> g_stop{false};
@@ -67,4 +67,4 @@ const char* stop_signal_name() {
   }
 }
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

@@ -1,10 +1,10 @@
-#include "cli/render_stats.hpp"
+#include "driver/render_stats.hpp"
 
 #include <sys/resource.h>
 
 #include <cstdio>
 
-namespace tracer::cli {
+namespace tracer::driver {
 
 namespace {
 
@@ -87,4 +87,4 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("\n");
 }
 
-}  // namespace tracer::cli
+}  // namespace tracer::driver

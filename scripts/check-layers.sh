@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The folders of src/ are layers (docs/ARCHITECTURE.md): a file may include its own folder or a
+# lower layer, never a higher one or a sibling of its own layer. Fails, listing every include
+# that points up or sideways.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# folder:layer, lowest first.
+layers="base:0 math:1 scene:2 parallel:2 film:3 accel:3 io:4 shade:4 render:5 driver:6 cli:7 mpi:7"
+declare -A rank
+for entry in $layers; do rank[${entry%%:*}]=${entry##*:}; done
+
+bad=0
+checked=0
+while IFS= read -r file; do
+  folder=$(echo "$file" | cut -d/ -f2)
+  if [[ -z ${rank[$folder]+x} ]]; then
+    echo "layers: $file: folder '$folder' has no layer (add it to scripts/check-layers.sh)" >&2
+    bad=$((bad + 1))
+    continue
+  fi
+  while IFS=: read -r line target; do
+    to=${target%%/*}
+    checked=$((checked + 1))
+    [[ $to == "$folder" ]] && continue
+    if [[ -z ${rank[$to]+x} ]] || ((rank[$to] >= rank[$folder])); then
+      echo "layers: $file:$line includes \"$target\": $to (layer ${rank[$to]:-?}) is not below $folder (layer ${rank[$folder]})" >&2
+      bad=$((bad + 1))
+    fi
+  done < <(grep -n '^#include "' "$file" | sed -E 's/^([0-9]+):#include "([^"]+)".*/\1:\2/')
+done < <(git ls-files --cached --others --exclude-standard 'src/*')
+
+if ((bad > 0)); then
+  echo "layers: $bad include(s) point up or sideways" >&2
+  exit 1
+fi
+echo "layers: $checked includes, every one to its own folder or a lower layer"

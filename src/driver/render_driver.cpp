@@ -1,0 +1,73 @@
+#include "driver/render_driver.hpp"
+
+#include <chrono>
+
+#include "driver/render_args.hpp"
+#include "io/image_io.hpp"
+#include "scene/camera.hpp"
+
+namespace tracer::driver {
+
+std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool round_per_pass) {
+  const std::vector<SampleRange> passes = sample_passes(settings);
+  if (!round_per_pass) return {passes};
+  std::vector<std::vector<SampleRange>> rounds;
+  for (const SampleRange& p : passes) rounds.push_back({p});
+  return rounds;
+}
+
+DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const RenderSettings& settings,
+                         const FrameSequence& seq, bool holds_image, bool round_per_pass, CancelFlag cancel,
+                         const RenderRound& render_round, const std::function<void(const std::string&)>& warn) {
+  using Clock = std::chrono::steady_clock;
+  DriveResult result;
+  bool warned_black = false;
+  for (int frame = 0; frame < seq.frames; ++frame) {
+    const std::string output = frame_output(seq.output, frame, seq.frames);
+    std::optional<Framebuffer> fb;
+    if (holds_image) fb.emplace(settings.width, settings.height);
+    const Camera cam(frame_camera(camera, frame, seq.frames, seq.orbit_degrees), settings.width, settings.height);
+    const RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
+    const auto write = [&] { write_render(output, *fb, settings.exposure, seq.exr); };
+    auto last_write = Clock::now();
+    uint32_t done = 0;
+    for (const std::vector<SampleRange>& round : rounds_of(settings, round_per_pass)) {
+      if (!render_round(ctx, round)) {
+        result.stopped = true;
+        result.output = output;
+        if (!fb) return result;
+        // A path render stopped after its first pass is a complete image, only noisier.
+        // --save-partial: unfinished tiles black, if any tile finished at all.
+        result.samples = fb->min_samples();
+        if (result.samples > 0 || (seq.save_partial && fb->max_samples() > 0)) {
+          write();
+          result.wrote_partial = true;
+        }
+        return result;
+      }
+      done = round.back().first + round.back().count;
+      const bool checkpoint_due =
+          seq.checkpoint_seconds && done < uint32_t(settings.spp) &&
+          std::chrono::duration<double>(Clock::now() - last_write).count() >= *seq.checkpoint_seconds;
+      if (fb && checkpoint_due) {
+        write();
+        ++result.checkpoints;
+        last_write = Clock::now();
+      }
+    }
+    if (!fb) continue;
+    write();
+    if (!warned_black && looks_black(*fb, settings.exposure)) {
+      warn(output + ": " + black_image_warning(settings, scene));
+      warned_black = true;
+    }
+    if (is_cancelled(cancel)) {  // arrived during the write, which is never torn
+      result.stopped = result.stopped_after_write = true;
+      result.output = output;
+      return result;
+    }
+  }
+  return result;
+}
+
+}  // namespace tracer::driver

@@ -1,0 +1,24 @@
+// Tone mapping: a framebuffer's linear radiance to the 8-bit sRGB image PNG and PPM files hold.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "film/framebuffer.hpp"
+
+namespace tracer {
+
+// 8-bit RGB, rows top to bottom.
+struct Image8 {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+// Exponential tone map 1 - exp(-exposure * L) of each pixel's radiance, then the sRGB transfer
+// curve, rounded to 8 bits.
+Image8 tonemap(const Framebuffer& fb, float exposure);
+
+// Whether tonemap(fb, exposure) is black in every pixel: a render a user must be told about.
+bool looks_black(const Framebuffer& fb, float exposure);
+
+}  // namespace tracer
