@@ -427,7 +427,7 @@ TEST_F(Cli, SigintStopsWithoutImageOrWithPartialImage) {
   const std::string exe = TRACER_EXE;
   for (const bool partial : {false, true}) {
     const std::string out = dir_ + (partial ? "/partial.png" : "/none.png");
-    const std::string cmd = "timeout --foreground --preserve-status -s INT 1 " + exe + " render " + scene +
+    const std::string cmd = "timeout --foreground --preserve-status -s INT 2 " + exe + " render " + scene +
                             " -q --accel brute --width 2048 --height 2048 -o " + out +
                             (partial ? " --save-partial" : "") + " 2>&1";
     const auto t0 = std::chrono::steady_clock::now();

@@ -171,7 +171,7 @@ class MtlSource : public tinyobj::MaterialReader {
     }
     strip_bom(text);
     for (const MtlMaterial& m : parse_mtl(text, name, cancel_)) {
-      tinyobj::material_t t;
+      tinyobj::material_t t{};  // zeroed: its texture options have no initialisers
       t.name = m.name;
       for (int i = 0; i < 3; ++i) {
         t.ambient[i] = m.ka[i];
