@@ -6,6 +6,7 @@
 #                                           and DOC's table is exactly what this run printed
 set -uo pipefail
 tracer=$(realpath "$1")
+tracer_mpi=$(dirname "$tracer")/tracer-mpi
 mode=${2:-}
 doc=${3:+$(realpath "$3")}
 work=$(mktemp -d)
@@ -62,6 +63,34 @@ mkfifo nowriter.obj
 inputs=$(ls)
 as_user=()
 [[ $(id -u) -eq 0 ]] && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+MPIRUN="mpirun --allow-run-as-root --oversubscribe"
+# Runs an mpirun command line, stops rank $1 with SIGSTOP once it renders, and once rank 0 has
+# written m.png continues and kills it; exits with mpirun's code.
+stall_rank() {
+  local rank=$1 victim="" pid
+  shift
+  "$@" &
+  local job=$!
+  for _ in $(seq 100); do
+    sleep 0.1
+    for pid in $(pgrep -f "tracer-mpi render"); do
+      tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$rank" && victim=$pid
+    done
+    [[ -n $victim ]] && break
+  done
+  sleep 1
+  kill -STOP "$victim"
+  # Rank 0 writes the image and aborts the job; the stopped rank can only die once continued.
+  local rank0=""
+  for pid in $(pgrep -f "tracer-mpi render"); do
+    tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=0" && rank0=$pid
+  done
+  for _ in $(seq 300); do [[ -f m.png ]] && ! kill -0 "$rank0" 2>/dev/null && break; sleep 0.1; done
+  kill -CONT "$victim"
+  kill -KILL "$victim" 2>/dev/null
+  wait "$job"
+}
+export -f stall_rank
 SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
 PATH_RENDER="render ok.obj -q --integrator path --spp 1000000 --width 128 --height 128 -o out.png"
 
@@ -130,18 +159,25 @@ cases=(
   "--integrator whitted --spp 4|tracer render --integrator whitted --spp 4 -q --width 8 --height 8 -o w.png|0"
   "a texture claiming 16384x16384 texels|tracer render bomb.obj --width 8 --height 8 -o b.png|0"
   "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
+  "tracer-mpi: one rank refuses a flag (an older binary)|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png --newer-flag|2"
+  "tracer-mpi: ranks given different --width|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 64 --height 32 -o m.png|2"
+  "tracer-mpi: rank 1 stopped (SIGSTOP) mid-render|stall_rank 1 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 1024 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m.png|1"
 )
 
 table=$'| case | command | exit | first line on stderr | left in the directory |\n|---|---|---:|---|---|\n'
 failures=0
 for c in "${cases[@]}"; do
   IFS='|' read -r name cmd expected <<< "$c"
-  run=${cmd//tracer /\"\$tracer\" }
+  run=${cmd//tracer-mpi /\"\$tracer_mpi\" }
+  run=${run//tracer /\"\$tracer\" }
   run=${run//USER /\"\$\{as_user[@]\}\" }
-  stderr=$(tracer=$tracer bash -c "as_user=(${as_user[*]}); $run" 2>&1 >/dev/null)
+  stderr=$(tracer=$tracer tracer_mpi=$tracer_mpi bash -c "as_user=(${as_user[*]}); $run" 2>&1 >/dev/null)
   code=$?
   # How many samples a stopped path render finished depends on the machine's speed: shown as N.
-  first=$(printf '%s\n' "$stderr" | head -n 1 | sed -E 's/after [0-9]+ of/after N of/')
+  # tracer's own first line (mpirun's banners may come first); the bound tracer-mpi derives from
+  # measured tile times is shown as N too.
+  first=$(printf '%s\n' "$stderr" | grep -m 1 '^tracer' || printf '%s\n' "$stderr" | head -n 1)
+  first=$(printf '%s\n' "$first" | sed -E 's/after [0-9]+ of/after N of/; s/within [0-9]+ s/within N s/')
   [[ -z $first ]] && first="(nothing)"
   left=$(comm -13 <(echo "$inputs") <(ls) | tr '\n' ' ')
   left=${left% }

@@ -277,5 +277,95 @@ TEST_F(MpiRender, CtrlCOnMpirunStopsEveryRank) {
   EXPECT_TRUE(pids_of_rank(0, dir_).empty() && pids_of_rank(1, dir_).empty() && pids_of_rank(2, dir_).empty());
 }
 
+// A rank that rejects its flags (an older binary on one node) or is given other render
+// settings: one error from rank 0 naming the rank and the cause, a non-zero exit, no image, on
+// 2 and 3 ranks, whichever rank it is.
+TEST_F(MpiRender, ARankWithOtherFlagsOrSettingsEndsTheJobWithOneError) {
+  const std::string out = dir_ + "/x.png";
+  const std::string good = std::string(kMpiExe) + " render --height 24 --integrator ao --ao 2 -q -o " + out;
+  const auto job = [&](int ranks, int odd, const std::string& extra) {
+    std::string command = std::string(kMpirun) + " --allow-run-as-root --oversubscribe";
+    for (int r = 0; r < ranks; ++r) command += std::string(r ? " :" : "") + " -np 1 " + good + (r == odd ? extra : "");
+    return run(command);
+  };
+  const struct {
+    std::string extra;
+    bool flag_error;      // the rank's own flags are refused (else they differ from rank 0's)
+    std::string message;  // in the one error line
+  } cases[] = {
+      {" --newer-flag", true, "The following argument was not expected: --newer-flag"},
+      {" --width 64", false, "renders with --width "},
+      {" --spp 2", false, "renders with --spp "},
+      {" --eye 0,1,4", false, "renders with --eye "},
+      {" --seed 7", false, "renders with --seed "},
+      {" --tile 8", false, "renders with --tile "},
+  };
+  for (const auto& c : cases) {
+    for (const auto& [ranks, odd] : {std::pair{2, 1}, {3, 2}, {3, 0}}) {
+      SCOPED_TRACE(c.extra + " on rank " + std::to_string(odd) + " of " + std::to_string(ranks));
+      const auto m = job(ranks, odd, c.extra);
+      EXPECT_EQ(m.exit_code, 2) << m.output;
+      // A refused flag names its rank; other settings name the rank that differs from rank 0.
+      const int named = c.flag_error || odd != 0 ? odd : 1;
+      EXPECT_NE(m.output.find("tracer-mpi: error: rank " + std::to_string(named) + " of " + std::to_string(ranks)),
+                std::string::npos)
+          << m.output;
+      EXPECT_NE(m.output.find(c.message), std::string::npos) << m.output;
+      EXPECT_EQ(own_lines(m.output), 1) << m.output;
+      EXPECT_FALSE(fs::exists(out));
+    }
+  }
+}
+
+// Stops rank `rank` of a running job with SIGSTOP once it renders, waits until rank 0 has written
+// `image`, then continues and kills it; returns the job's exit code and output.
+test::CommandResult stall_one_rank(const std::string& command, const std::string& dir, int rank,
+                                   const std::string& image) {
+  const std::string log = dir + "/log.txt";
+  const pid_t launcher = launch(command, log);
+  pid_t victim = -1;
+  for (int i = 0; i < 200 && victim < 0; ++i) {  // up to 20 s for the job to start
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const std::vector<pid_t> pids = pids_of_rank(rank, dir);
+    if (pids.size() == 1) victim = pids[0];
+  }
+  if (victim > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // loaded, built, into the render
+    ::kill(victim, SIGSTOP);
+    // Rank 0 writes the image and aborts the job; the stopped rank can only die once continued.
+    for (int i = 0; i < 600 && !(fs::exists(image) && pids_of_rank(0, dir).empty()); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    ::kill(victim, SIGCONT);
+    ::kill(victim, SIGKILL);
+  }
+  const auto [code, seconds] = wait_for(launcher);
+  return {code, read_file(log)};
+}
+
+// A rank that stops answering mid-render (SIGSTOP): rank 0 hands its tiles to the others,
+// finishes, writes the image (the same floats as one process's), and ends the job with an error
+// naming the rank; on 2 ranks (rank 0 renders the tiles itself) and 3.
+TEST_F(MpiRender, AStalledRankIsWorkedAroundAndNamed) {
+  const std::string common = " render --integrator path --spp 1024 --width 96 --height 96 --threads 1 -q --exr float";
+  const auto r = test::run_tracer(common + " -o " + dir_ + "/ref.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string expected = read_file(dir_ + "/ref.exr");
+  for (const auto& [ranks, victim] : {std::pair{2, 1}, {3, 2}}) {
+    SCOPED_TRACE("rank " + std::to_string(victim) + " of " + std::to_string(ranks));
+    const std::string image = dir_ + "/x.exr";
+    fs::remove(image);
+    const auto m =
+        stall_one_rank(mpirun(ranks) + kMpiExe + common + " --rank-timeout 1 -o " + image, dir_, victim, image);
+    EXPECT_NE(m.exit_code, 0) << m.output;
+    EXPECT_NE(m.output.find("tracer-mpi: error: rank " + std::to_string(victim) + " of " + std::to_string(ranks) +
+                            " stopped answering"),
+              std::string::npos)
+        << m.output;
+    EXPECT_EQ(read_file(image), expected);
+    EXPECT_EQ(own_lines(m.output), 1) << m.output;
+  }
+}
+
 }  // namespace
 }  // namespace tracer

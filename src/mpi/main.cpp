@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -16,6 +17,7 @@
 #include <mutex>
 #include <new>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -59,7 +61,42 @@ struct Setup {
   int exit_code = 0;
   std::string error;
   double load_ms = 0;
+  std::string fingerprint;  // settings_fingerprint(), once ready
 };
+
+// Every setting that changes a pixel or the tiles, one "flag value" line each, in a fixed order:
+// ranks must agree on all of them (the scene itself is checksummed apart).
+std::string settings_fingerprint(const Setup& s, const driver::RenderArgs& args) {
+  std::ostringstream f;
+  f.precision(9);
+  const RenderSettings& r = s.settings;
+  const auto vec = [](Vec3 v) {
+    std::ostringstream o;
+    o.precision(9);
+    o << v.x << "," << v.y << "," << v.z;
+    return o.str();
+  };
+  f << "--width " << r.width << "\n--height " << r.height << "\n--integrator "
+    << name_of<Integrator>(kIntegratorNames, r.integrator) << "\n--spp " << r.spp << "\n--max-depth " << r.max_depth
+    << "\n--ao " << r.ao_samples << "\n--ao-distance " << r.ao_distance << "\n--ambient " << r.ambient << "\n--seed "
+    << r.seed << "\n--light-sampling " << name_of<LightSampling>(kLightSamplingNames, r.light_sampling) << "\n--env "
+    << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
+    << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--frames " << args.frames << "\n--orbit "
+    << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
+    << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block
+    << "\n";
+  return f.str();
+}
+
+// The first line of `theirs` that differs from `ours`, or "".
+std::pair<std::string, std::string> first_difference(const std::string& ours, const std::string& theirs) {
+  std::istringstream a(ours), b(theirs);
+  for (std::string x, y; std::getline(a, x);) {
+    if (!std::getline(b, y)) return {x, "(nothing)"};
+    if (x != y) return {x, y};
+  }
+  return {};
+}
 
 Setup set_up(const driver::RenderArgs& args, const MpiSession& session) {
   Setup s;
@@ -130,10 +167,18 @@ constexpr const char* kStopMessage =
     "tracer-mpi: rank 0 stopped by a signal (mpirun sends it on Ctrl-C and when another rank fails: see its "
     "message); no image written\n";
 
-int run(const driver::RenderArgs& args, MpiSession& session) {
+// `parse_error`: this rank's flags did not parse (exit code 2 and the message); it still joins the
+// first collective, so rank 0 can name it and end the job instead of waiting for it.
+int run(const driver::RenderArgs& args, MpiSession& session, const std::string& parse_error, double rank_timeout) {
   driver::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
   const ThreadLimit thread_limit(args.threads.value_or(0));
-  Setup setup = set_up(args, session);
+  // Built in place, never moved: the accelerator points into the scene.
+  Setup setup = parse_error.empty() ? set_up(args, session) : Setup{};
+  if (!parse_error.empty()) {
+    setup.exit_code = 2;
+    setup.error = parse_error;
+  }
+  if (setup.error.empty()) setup.fingerprint = settings_fingerprint(setup, args);
 
   // Every rank's readiness and scene checksum, judged on rank 0, which says what is wrong once.
   const std::vector<std::string> errors =
@@ -141,16 +186,19 @@ int run(const driver::RenderArgs& args, MpiSession& session) {
   const std::vector<uint64_t> checksums = session.all_gather(setup.error.empty() ? scene_checksum(*setup.scene) : 0);
   const int threads = setup.error.empty() ? thread_count(setup.sched) : 0;
   const std::vector<uint64_t> all_threads = session.all_gather(uint64_t(threads));
+  const std::vector<std::string> fingerprints = session.gather_strings(setup.fingerprint);
   int verdict = 0;
   if (session.root()) {
+    const bool same_everywhere =
+        std::all_of(errors.begin(), errors.end(), [&](const std::string& e) { return e == errors[0]; });
     for (int r = 0; r < session.size() && verdict == 0; ++r) {
       const std::string& e = errors[size_t(r)];
       if (e.empty()) continue;
       const size_t space = e.find(' ');
       verdict = std::stoi(e.substr(0, space));
       const std::string what = e.substr(space + 1);
-      if (verdict == 2) {
-        say("tracer-mpi: error: " + what);  // the same on every rank
+      if (verdict == 2 && same_everywhere) {
+        say("tracer-mpi: error: " + what);  // the same flags on every rank
       } else {
         say("tracer-mpi: error: rank " + std::to_string(r) + " of " + std::to_string(session.size()) + ": " + what);
       }
@@ -165,6 +213,14 @@ int run(const driver::RenderArgs& args, MpiSession& session) {
         verdict = 1;
       }
     }
+    // After the scene: another scene frames another default camera.
+    for (int r = 1; r < session.size() && verdict == 0; ++r) {
+      const auto [ours, theirs] = first_difference(fingerprints[0], fingerprints[size_t(r)]);
+      if (ours.empty()) continue;
+      say("tracer-mpi: error: rank " + std::to_string(r) + " of " + std::to_string(session.size()) + " renders with " +
+          theirs + ", rank 0 with " + ours + ": every rank must be given the same render settings");
+      verdict = 2;
+    }
   }
   verdict = session.broadcast(verdict);
   if (verdict != 0) {
@@ -178,8 +234,8 @@ int run(const driver::RenderArgs& args, MpiSession& session) {
   const Accelerator& accel = *setup.accel;
   const RenderSettings& settings = setup.settings;
   const std::vector<Tile> tiles = tiles_for(settings.width, settings.height, setup.sched);
-  int remote_threads = 0;
-  for (int r = 1; r < session.size(); ++r) remote_threads += int(all_threads[size_t(r)]);
+  StallWatch watch;
+  watch.floor_seconds = rank_timeout;
 
   RankReport mine;
   double server_ms = 0;  // rank 0: time spent on messages (requests, returned tiles, done)
@@ -206,13 +262,24 @@ int run(const driver::RenderArgs& args, MpiSession& session) {
     };
     if (session.root()) {
       Framebuffer& fb = *ctx.framebuffer;
-      TileServer server(tiles, remote_threads, session.size(), round_serial);
+      TileServer server(tiles, all_threads, round_serial, watch);
       std::exception_ptr own_failure;
       std::thread own([&] {
         try {
           parallel_pull(
               threads, [&] { return server.take(); },
-              [&](uint32_t i) { count(render_one(accel, ctx, round, fb, tiles[i]), tiles[i]); });
+              [&](const TileGrant& g) {
+                const Tile& t = tiles[g.tile];
+                if (!g.reissued) {
+                  count(render_one(accel, ctx, round, fb, t), t);
+                  server.own_done(g.tile);
+                  return;
+                }
+                // Taken back from a late rank: its copy may still come, so render apart.
+                Framebuffer window(t);
+                count(render_one(accel, ctx, round, window, t), t);
+                server.commit(g.tile, window, fb, samples);
+              });
         } catch (...) {
           own_failure = std::current_exception();
         }
@@ -265,6 +332,28 @@ int run(const driver::RenderArgs& args, MpiSession& session) {
       driver::drive_render(scene, setup.camera, settings, frames, session.root(), args.checkpoint.has_value(), nullptr,
                            render_round, [](const std::string& w) { say("tracer-mpi: warning: " + w); });
   const int checkpoints = driven.checkpoints;
+  if (session.root()) {
+    const auto ranks = [&](const std::vector<int>& list) {
+      std::string text;
+      for (const int r : list) text += (text.empty() ? "" : ", ") + std::to_string(r);
+      return text;
+    };
+    if (!watch.recovered.empty()) {
+      say("tracer-mpi: warning: rank " + ranks(watch.recovered) + " of " + std::to_string(session.size()) +
+          " was late (a tile out for more than " + std::to_string(int(watch.overdue_after())) +
+          " s); its tiles were also rendered by others, the first copy kept");
+    }
+    if (!watch.gone.empty()) {
+      // The image is complete and written; the silent rank cannot join the statistics, so the
+      // job ends here, with its runtime told to stop every rank.
+      if (progress) progress->stop();
+      say("tracer-mpi: error: rank " + ranks(watch.gone) + " of " + std::to_string(session.size()) +
+          " stopped answering (no tile back within " + std::to_string(int(watch.overdue_after())) +
+          " s); the other ranks rendered its tiles and the image was written; ending the job");
+      driver::install_immediate_stop_handlers(nullptr);  // the runtime's SIGTERM needs no second message
+      MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+  }
   if (progress) progress->stop();
   mine.render_ms = ms_since(t_render);
   mine.rays = counts.load().total();
@@ -341,15 +430,22 @@ int main(int argc, char** argv) {
   render->add_flag("--stats", args.stats, "print timings, ray counts and each rank's tiles, rays and idle time");
   render->add_option("--stats-json", args.stats_json, "write the statistics as JSON to this file (rank 0)");
   render->add_flag("-q,--quiet", args.quiet, "no progress bar, no loader warnings");
+  double rank_timeout = mpi::StallWatch{}.floor_seconds;
+  render
+      ->add_option("--rank-timeout", rank_timeout,
+                   "seconds a tile may be out with a rank before its tiles go to others (at least; 8x the slowest "
+                   "tile so far if more)")
+      ->check(CLI::Range(0.1, 1e6))
+      ->capture_default_str();
+  std::string parse_error;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return session->root() ? app.exit(e) : 0;
-    if (session->root()) mpi::say(std::string("tracer-mpi: error: ") + e.what() + " (see tracer-mpi --help)");
-    return 2;
+    parse_error = std::string(e.what()) + " (see tracer-mpi --help)";
   }
   try {
-    return mpi::run(args, *session);
+    return mpi::run(args, *session, parse_error, rank_timeout);
   } catch (const std::exception& e) {
     mpi::say("tracer-mpi: error: rank " + std::to_string(session->rank()) + ": " + e.what());
     MPI_Abort(MPI_COMM_WORLD, 1);

@@ -41,21 +41,118 @@ class Backoff {
 
 int pass_tag(uint32_t serial, int kind) { return kTagPassBase + int(serial % kPassSlots) * kKinds + kind; }
 
-TileServer::TileServer(const std::vector<Tile>& tiles, int remote_threads, int ranks, uint32_t pass_serial)
-    : tiles_(tiles), remote_threads_(remote_threads), serial_(pass_serial), tiles_per_rank_(size_t(ranks), 0) {}
+TileServer::TileServer(const std::vector<Tile>& tiles, const std::vector<uint64_t>& rank_threads, uint32_t pass_serial,
+                       StallWatch& watch)
+    : tiles_(tiles),
+      rank_threads_(rank_threads),
+      serial_(pass_serial),
+      watch_(watch),
+      owner_(tiles.size(), 0),
+      handed_(tiles.size()),
+      in_(tiles.size(), 0),
+      late_(rank_threads.size(), 0),
+      done_(rank_threads.size(), 0),
+      tiles_per_rank_(rank_threads.size(), 0) {
+  for (const int r : watch_.gone) late_[size_t(r)] = 1;
+}
 
-std::optional<uint32_t> TileServer::take() {
-  const uint32_t t = next_.fetch_add(1, std::memory_order_relaxed);
-  if (t >= tiles_.size()) return std::nullopt;
-  own_tiles_.fetch_add(1, std::memory_order_relaxed);
-  return t;
+std::optional<TileGrant> TileServer::take() {
+  for (;;) {
+    {
+      const std::lock_guard lock(mutex_);
+      if (next_ < tiles_.size()) {
+        const uint32_t t = next_++;
+        owner_[t] = 0;
+        ++tiles_per_rank_[0];
+        return TileGrant{t, false};
+      }
+      if (!reissue_.empty()) {
+        const uint32_t t = reissue_.front();
+        reissue_.pop_front();
+        owner_[t] = 0;
+        ++tiles_per_rank_[0];
+        return TileGrant{t, true};
+      }
+      if (in_count_ == tiles_.size()) return std::nullopt;
+    }
+    // Tiles are still out with other ranks; one of them may come back to us.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+void TileServer::received(uint32_t t) {
+  in_[t] = 1;
+  ++in_count_;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - handed_[t]).count();
+  if (owner_[t] != 0) watch_.slowest_seconds = std::max(watch_.slowest_seconds, seconds);
+}
+
+void TileServer::own_done(uint32_t t) {
+  const std::lock_guard lock(mutex_);
+  if (!in_[t]) received(t);
+}
+
+void TileServer::commit(uint32_t t, const Framebuffer& window, Framebuffer& fb, uint32_t samples) {
+  // Under the mutex, as serve() adds the tiles other ranks return: one copy of a tile counts.
+  const std::lock_guard lock(mutex_);
+  if (in_[t]) return;
+  const Tile& tile = tiles_[t];
+  const Vec3* sums = window.sums();
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    for (int x = tile.x0; x < tile.x1; ++x) {
+      fb.add(x, y, sums[size_t(y - tile.y0) * size_t(tile.x1 - tile.x0) + size_t(x - tile.x0)], samples);
+    }
+  }
+  received(t);
+}
+
+void TileServer::check_overdue(std::chrono::steady_clock::time_point now) {
+  const double limit = watch_.overdue_after();
+  for (uint32_t t = 0; t < next_; ++t) {
+    const int r = owner_[t];
+    if (in_[t] || r == 0 || late_[size_t(r)]) continue;
+    if (std::chrono::duration<double>(now - handed_[t]).count() <= limit) continue;
+    late_[size_t(r)] = 1;
+    for (uint32_t u = 0; u < next_; ++u) {
+      if (!in_[u] && owner_[u] == r) reissue_.push_back(u);
+    }
+  }
 }
 
 void TileServer::serve(Framebuffer& fb, uint32_t samples) {
   std::vector<char> buffer;
-  int done_threads = 0;
   Backoff backoff;
-  while (done_threads < remote_threads_) {
+  using Clock = std::chrono::steady_clock;
+  auto last_check = Clock::now();
+  auto all_in_since = Clock::time_point{};
+  const auto finished = [&] {
+    // Every tile in, and every rank still answering done.
+    if (in_count_ != tiles_.size()) return false;
+    for (size_t r = 1; r < rank_threads_.size(); ++r) {
+      if (!late_[r] && done_[r] < rank_threads_[r]) return false;
+    }
+    return true;
+  };
+  for (;;) {
+    {
+      const std::lock_guard lock(mutex_);
+      const auto now = Clock::now();
+      if (finished()) break;
+      if (std::chrono::duration<double>(now - last_check).count() > 0.05) {
+        last_check = now;
+        check_overdue(now);
+        // Every tile is in but some rank has not said it is done: it holds no tile to be late
+        // with, so it is late once it has been silent as long as a tile may be out.
+        if (in_count_ == tiles_.size()) {
+          if (all_in_since == Clock::time_point{}) all_in_since = now;
+          if (std::chrono::duration<double>(now - all_in_since).count() > watch_.overdue_after()) {
+            for (size_t r = 1; r < rank_threads_.size(); ++r) {
+              if (done_[r] < rank_threads_[r]) late_[r] = 1;
+            }
+          }
+        }
+      }
+    }
     // This pass's messages, and failures; a later pass's requests wait in the queue.
     int flag = 0;
     MPI_Status status;
@@ -69,7 +166,7 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
       continue;
     }
     backoff.reset();
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     int bytes = 0;
     MPI_Get_count(&status, MPI_BYTE, &bytes);
     buffer.resize(size_t(bytes));
@@ -77,39 +174,65 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
     int32_t first = -1;
     if (size_t(bytes) >= sizeof first) std::memcpy(&first, buffer.data(), sizeof first);
     const int kind = status.MPI_TAG == kTagFailure ? -1 : (status.MPI_TAG - kTagPassBase) % kKinds;
-    switch (kind) {
-      case -1:
-        throw RankFailed(status.MPI_SOURCE, std::string(buffer.begin(), buffer.end()));
-      case kRequest: {
-        const uint32_t next = next_.fetch_add(1, std::memory_order_relaxed);
-        const int32_t answer = next < tiles_.size() ? int32_t(next) : -1;
-        if (answer >= 0) ++tiles_per_rank_[size_t(status.MPI_SOURCE)];
-        MPI_Send(&answer, 1, MPI_INT32_T, status.MPI_SOURCE, kTagAnswer + first, MPI_COMM_WORLD);
-        break;
-      }
-      case kResult: {
-        if (first < 0 || size_t(first) >= tiles_.size()) break;
-        const Tile& t = tiles_[size_t(first)];
-        if (size_t(bytes) != sizeof first + size_t(t.pixel_count()) * 3 * sizeof(float)) break;
-        const char* p = buffer.data() + sizeof first;
-        for (int y = t.y0; y < t.y1; ++y) {
-          for (int x = t.x0; x < t.x1; ++x) {
-            float c[3];
-            std::memcpy(c, p, sizeof c);
-            p += sizeof c;
-            fb.add(x, y, Vec3{c[0], c[1], c[2]}, samples);
+    const auto source = size_t(status.MPI_SOURCE);
+    if (kind == -1) throw RankFailed(status.MPI_SOURCE, std::string(buffer.begin(), buffer.end()));
+    {
+      const std::lock_guard lock(mutex_);
+      switch (kind) {
+        case kRequest: {
+          // A late rank gets no more tiles: told the pass is over, it says it is done.
+          int32_t answer = -1;
+          if (!late_[source] && next_ < tiles_.size()) {
+            answer = int32_t(next_++);
+          } else if (!late_[source] && !reissue_.empty()) {
+            answer = int32_t(reissue_.front());
+            reissue_.pop_front();
           }
+          if (answer >= 0) {
+            owner_[size_t(answer)] = int(source);
+            handed_[size_t(answer)] = Clock::now();
+            ++tiles_per_rank_[source];
+          }
+          MPI_Send(&answer, 1, MPI_INT32_T, status.MPI_SOURCE, kTagAnswer + first, MPI_COMM_WORLD);
+          break;
         }
-        break;
+        case kResult: {
+          // The first copy of a tile counts; a late rank's copy of a reissued tile is dropped.
+          if (first < 0 || size_t(first) >= tiles_.size() || in_[size_t(first)]) break;
+          const Tile& t = tiles_[size_t(first)];
+          if (size_t(bytes) != sizeof first + size_t(t.pixel_count()) * 3 * sizeof(float)) break;
+          const char* p = buffer.data() + sizeof first;
+          for (int y = t.y0; y < t.y1; ++y) {
+            for (int x = t.x0; x < t.x1; ++x) {
+              float c[3];
+              std::memcpy(c, p, sizeof c);
+              p += sizeof c;
+              fb.add(x, y, Vec3{c[0], c[1], c[2]}, samples);
+            }
+          }
+          received(uint32_t(first));
+          break;
+        }
+        case kDone:
+          ++done_[source];
+          break;
+        default:
+          break;
       }
-      case kDone:
-        ++done_threads;
-        break;
-      default:
-        break;
     }
-    busy_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    busy_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     ++messages_;
+  }
+  // A late rank whose every thread still said it was done within the pass is back; one that did
+  // not is gone for the rest of the job.
+  const std::lock_guard lock(mutex_);
+  for (size_t r = 1; r < rank_threads_.size(); ++r) {
+    if (!late_[r] || watch_.is_gone(int(r))) continue;
+    if (done_[r] >= rank_threads_[r]) {
+      watch_.recovered.push_back(int(r));
+    } else {
+      watch_.gone.push_back(int(r));
+    }
   }
 }
 

@@ -7,8 +7,11 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -31,35 +34,74 @@ struct RankFailed : std::runtime_error {
 // last tile of this one, and that request must wait for the next pass, not end this one.
 int pass_tag(uint32_t serial, int kind);
 
+// What rank 0 knows of its peers' health over a whole job: how long the slowest tile took to come
+// back, and which ranks stopped answering. A tile is overdue once it has been out longer than
+// overdue_after(): its rank is then late, and its tiles are handed to others.
+struct StallWatch {
+  double floor_seconds = 10.0;  // --rank-timeout
+  double slowest_seconds = 0;   // the longest any tile took from hand-out to its sums, so far
+  // Never less than the floor, and 8 times the slowest tile seen: tiles of one image differ in
+  // cost, and one thread's round trip covers up to two tiles (a request stays in flight while it
+  // renders), so a rank is only called late when it is far slower than every tile so far.
+  double overdue_after() const { return std::max(floor_seconds, 8.0 * slowest_seconds); }
+  std::vector<int> gone;       // ranks that never answered again: excluded for the rest of the job
+  std::vector<int> recovered;  // ranks that were late but came back within their pass
+  bool is_gone(int rank) const { return std::find(gone.begin(), gone.end(), rank) != gone.end(); }
+};
+
+// A tile for one of rank 0's own threads: a fresh one (rendered straight into the image), or one
+// taken back from a late rank (rendered into a window of its own and then commit()ed, so that
+// whichever copy comes first counts, once).
+struct TileGrant {
+  uint32_t tile;
+  bool reissued;
+};
+
 // Rank 0's side of one pass.
 class TileServer {
  public:
-  // `remote_threads`: the render threads of all other ranks; each says when it is done.
-  TileServer(const std::vector<Tile>& tiles, int remote_threads, int ranks, uint32_t pass_serial);
-  // The next tile for one of rank 0's own threads; thread-safe.
-  std::optional<uint32_t> take();
+  // `rank_threads[r]`: the render threads of rank r (rank 0's own not counted); each says when it
+  // is done. `watch` carries what earlier passes learnt and learns from this one.
+  TileServer(const std::vector<Tile>& tiles, const std::vector<uint64_t>& rank_threads, uint32_t pass_serial,
+             StallWatch& watch);
+  // The next tile for one of rank 0's own threads, or nothing when every tile of the pass is in;
+  // waits while tiles are out with other ranks (one may be taken back). Thread-safe.
+  std::optional<TileGrant> take();
+  // One of rank 0's own fresh tiles is rendered.
+  void own_done(uint32_t tile);
+  // Adds a reissued tile's sums (a window) unless another copy came first.
+  void commit(uint32_t tile, const Framebuffer& window, Framebuffer& fb, uint32_t samples);
   // Answers the other ranks' requests and adds the tiles they return into `fb` (as the sum of
-  // `samples` samples per pixel) until every remote thread has said it is done. Throws
-  // RankFailed.
+  // `samples` samples per pixel) until every tile is in and every rank still answering has said
+  // it is done. Throws RankFailed.
   void serve(Framebuffer& fb, uint32_t samples);
   // Time spent handling messages (receiving, adding a tile, answering), and their number.
   double busy_ms() const { return busy_ms_; }
   uint64_t messages() const { return messages_; }
   // Tiles handed out per rank in this pass (rank 0's own included): read once rank 0's own
   // threads have finished.
-  std::vector<uint64_t> tiles_per_rank() const {
-    std::vector<uint64_t> v = tiles_per_rank_;
-    v[0] = own_tiles_.load();
-    return v;
-  }
+  std::vector<uint64_t> tiles_per_rank() const { return tiles_per_rank_; }
 
  private:
+  // Called under mutex_: marks tile t in (its sums added), and notes how long it was out.
+  void received(uint32_t t);
+  // Called under mutex_: ranks holding overdue tiles become late, their tiles reissued.
+  void check_overdue(std::chrono::steady_clock::time_point now);
+
   const std::vector<Tile>& tiles_;
-  int remote_threads_;
+  std::vector<uint64_t> rank_threads_;
   uint32_t serial_;
-  std::atomic<uint32_t> next_{0};
+  StallWatch& watch_;
+  std::mutex mutex_;
+  uint32_t next_ = 0;                                          // the next fresh tile
+  std::vector<int> owner_;                                     // per tile: the rank it was last handed to
+  std::vector<std::chrono::steady_clock::time_point> handed_;  // per tile: when
+  std::vector<char> in_;                                       // per tile: its sums are added
+  uint32_t in_count_ = 0;
+  std::deque<uint32_t> reissue_;  // tiles taken back from late ranks
+  std::vector<char> late_;        // per rank
+  std::vector<uint64_t> done_;    // per rank: threads that said they are done
   std::vector<uint64_t> tiles_per_rank_;
-  std::atomic<uint64_t> own_tiles_{0};
   double busy_ms_ = 0;
   uint64_t messages_ = 0;
 };
