@@ -10,6 +10,7 @@
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
 #include "io/image_io.hpp"
+#include "parallel/executor.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
 #include "scene/obj_loader.hpp"
@@ -200,6 +201,11 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
   LoadLimits limits;
   limits.max_obj_bytes = a.max_input_mib << 20;
   limits.textures.max_total_bytes = a.max_texture_mib << 20;
+  // Textures are read and decoded on every thread the render may use.
+  const Executor executor(Strategy::Tbb);
+  limits.for_each = [&executor](size_t count, const std::function<void(size_t)>& body) {
+    executor.for_each(count, body);
+  };
   const WarningSink silent = [](const std::string&) {};
   const WarningSink warn = quiet ? silent : WarningSink{};
   if (!a.view.empty()) {

@@ -323,44 +323,73 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     }
   }
 
-  // map_Kd textures, each file loaded once; one warning for all that are missing or unreadable.
-  // The other maps (bump, Ks, Ka, alpha) are not used by any integrator, so not read.
+  // map_Kd textures, each file read and decoded once; one warning for all that are missing or
+  // unreadable. The other maps (bump, Ks, Ka, alpha) are not used by any integrator, so not read.
+  // 1. Which file each material names (sequential: directory listings are cached).
+  std::vector<std::string> problem(parsed.materials.size());
+  std::vector<uint32_t> file_of(parsed.materials.size(), kInvalidIndex);
+  std::vector<fs::path> files;
+  std::map<fs::path, uint32_t> file_index;
+  FileFinder finder;
+  for (size_t i = 0; i < parsed.materials.size(); ++i) {
+    const std::string& texname = parsed.materials[i].diffuse_texname;
+    if (texname.empty()) continue;
+    if (const std::optional<fs::path> file = finder.find(base_dir, texname); !file) {
+      problem[i] = "not found";
+    } else {
+      const auto [it, fresh] = file_index.try_emplace(*file, uint32_t(files.size()));
+      if (fresh) files.push_back(*file);
+      file_of[i] = it->second;
+    }
+  }
+  // 2. Every file read and its header checked, in parallel; 3. the total budget decided in file
+  // order (so which texture is left out never depends on threads); 4. the rest decoded in parallel.
+  std::vector<EncodedTexture> encoded(files.size());
+  std::vector<std::string> file_problem(files.size());
+  std::vector<std::optional<Texture>> decoded(files.size());
+  const auto guarded = [&](size_t k, auto&& work) {
+    try {
+      work();
+    } catch (const InputError& e) {
+      file_problem[k] = e.what();
+    }
+  };
+  limits.for_each(files.size(),
+                  [&](size_t k) { guarded(k, [&] { encoded[k] = read_texture(files[k], limits.textures, cancel); }); });
+  throw_if_cancelled(cancel);
+  uint64_t texture_bytes = 0;
+  for (size_t k = 0; k < files.size(); ++k) {
+    if (!file_problem[k].empty()) continue;
+    if (texture_bytes + encoded[k].decoded_bytes() > limits.textures.max_total_bytes) {
+      file_problem[k] = "the scene's textures would take more than " +
+                        std::to_string(limits.textures.max_total_bytes >> 20) + " MiB (--max-texture-mib raises it)";
+      encoded[k] = {};
+      continue;
+    }
+    texture_bytes += encoded[k].decoded_bytes();
+  }
+  limits.for_each(files.size(), [&](size_t k) {
+    if (file_problem[k].empty()) guarded(k, [&] { decoded[k] = decode_texture(encoded[k]); });
+    encoded[k] = {};  // the encoded bytes are no longer needed
+  });
+  throw_if_cancelled(cancel);
+  std::vector<uint32_t> texture_of(files.size(), kInvalidIndex);
+  for (size_t k = 0; k < files.size(); ++k) {
+    if (!decoded[k]) continue;
+    texture_of[k] = uint32_t(scene.textures.size());
+    scene.textures.push_back(std::move(*decoded[k]));
+  }
   size_t missing_textures = 0;
   std::string first_missing;
-  std::map<fs::path, uint32_t> texture_index;
-  std::map<std::string, std::string> failed;  // name as the MTL gives it -> why it is not used
-  FileFinder finder;
-  uint64_t texture_bytes = 0;
-  for (const tinyobj::material_t& m : parsed.materials) {
+  for (size_t i = 0; i < parsed.materials.size(); ++i) {
+    const tinyobj::material_t& m = parsed.materials[i];
     Material mat = to_material(m, name);
-    if (!m.diffuse_texname.empty()) {
-      throw_if_cancelled(cancel);
-      std::string problem;
-      if (const auto seen = failed.find(m.diffuse_texname); seen != failed.end()) {
-        problem = seen->second;
-      } else if (const std::optional<fs::path> file = finder.find(base_dir, m.diffuse_texname); !file) {
-        problem = "not found";
-      } else if (const auto it = texture_index.find(*file); it != texture_index.end()) {
-        mat.diffuse_texture = it->second;
-      } else {
-        try {
-          Texture texture = load_texture(*file, limits.textures, cancel);
-          const uint64_t bytes = texture.srgb().size();
-          if (texture_bytes + bytes > limits.textures.max_total_bytes) {
-            throw InputError("the scene's textures would take more than " +
-                             std::to_string(limits.textures.max_total_bytes >> 20) +
-                             " MiB (--max-texture-mib raises it)");
-          }
-          texture_bytes += bytes;
-          scene.textures.push_back(std::move(texture));
-          mat.diffuse_texture = texture_index[*file] = static_cast<uint32_t>(scene.textures.size() - 1);
-        } catch (const InputError& e) {
-          problem = e.what();
-        }
-      }
-      if (!problem.empty()) failed.emplace(m.diffuse_texname, problem);
-      if (!problem.empty() && missing_textures++ == 0) first_missing = in_quotes(m.diffuse_texname) + ": " + problem;
+    if (file_of[i] != kInvalidIndex) {
+      mat.diffuse_texture = texture_of[file_of[i]];
+      if (mat.diffuse_texture == kInvalidIndex) problem[i] = file_problem[file_of[i]];
     }
+    if (!problem[i].empty() && missing_textures++ == 0)
+      first_missing = in_quotes(m.diffuse_texname) + ": " + problem[i];
     scene.materials.push_back(std::move(mat));
   }
   if (missing_textures > 0) {

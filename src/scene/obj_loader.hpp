@@ -22,10 +22,19 @@ using WarningSink = std::function<void(const std::string&)>;
 // including a pipe; "-" reads standard input (MTL files then resolve from the current directory).
 // Throws InputError with a one-line message naming the file and, where there is one, the line;
 // Cancelled when `cancel` is set during loading.
-// What a load may read: the OBJ's size (MTL files: 64 MiB each) and the textures' texels.
+// body(i) for every i in [0, count), possibly in parallel: how textures are read and decoded.
+// The loader knows nothing of threads; the caller hands it an executor's loop.
+using ForEach = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
+inline void sequential_for_each(size_t count, const std::function<void(size_t)>& body) {
+  for (size_t i = 0; i < count; ++i) body(i);
+}
+
+// What a load may read (the OBJ's size, MTL files 64 MiB each, the textures' texels), and the
+// loop it reads and decodes textures with.
 struct LoadLimits {
   uint64_t max_obj_bytes = kDefaultMaxInputBytes;
   TextureLimits textures;
+  ForEach for_each = sequential_for_each;
 };
 
 Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr,

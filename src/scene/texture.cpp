@@ -60,30 +60,40 @@ Vec3 Texture::bilinear(float u, float v) const {
          (texel(x0, y1) * (1.0f - ax) + texel(x1, y1) * ax) * ay;
 }
 
-Texture load_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
-  const std::string name = path.string();
+EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
+  EncodedTexture t;
+  t.name = path.string();
   struct stat st {};
-  if (::stat(name.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-    throw InputError(name + ": not a regular file" + (S_ISFIFO(st.st_mode) ? " (a FIFO)" : ""));
+  if (::stat(t.name.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw InputError(t.name + ": not a regular file" + (S_ISFIFO(st.st_mode) ? " (a FIFO)" : ""));
   }
   // The encoded file is far smaller than its texels; a file this large is no texture.
-  const std::string bytes = read_input(name, cancel, limits.max_texels * 3 + (uint64_t(64) << 20));
-  if (bytes.size() > size_t(std::numeric_limits<int>::max())) throw InputError(name + ": too large to decode");
-  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
-  const int size = int(bytes.size());
+  t.bytes = read_input(t.name, cancel, limits.max_texels * 3 + (uint64_t(64) << 20));
+  if (t.bytes.size() > size_t(std::numeric_limits<int>::max())) throw InputError(t.name + ": too large to decode");
+  int channels = 0;
+  if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size()), &t.width, &t.height,
+                             &channels)) {
+    throw InputError(t.name + ": cannot read texture: " + stbi_failure_reason());
+  }
+  if (uint64_t(t.width) * uint64_t(t.height) > limits.max_texels) {
+    throw InputError(t.name + ": " + std::to_string(t.width) + "x" + std::to_string(t.height) +
+                     " texels, more than the " + std::to_string(limits.max_texels) + " a texture may have");
+  }
+  return t;
+}
+
+Texture decode_texture(const EncodedTexture& t) {
   int w = 0, h = 0, channels = 0;
-  if (!stbi_info_from_memory(data, size, &w, &h, &channels)) {
-    throw InputError(name + ": cannot read texture: " + stbi_failure_reason());
-  }
-  if (uint64_t(w) * uint64_t(h) > limits.max_texels) {
-    throw InputError(name + ": " + std::to_string(w) + "x" + std::to_string(h) + " texels, more than the " +
-                     std::to_string(limits.max_texels) + " a texture may have");
-  }
-  unsigned char* texels = stbi_load_from_memory(data, size, &w, &h, &channels, 3);
-  if (!texels) throw InputError(name + ": cannot read texture: " + stbi_failure_reason());
+  unsigned char* texels = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size()),
+                                                &w, &h, &channels, 3);
+  if (!texels) throw InputError(t.name + ": cannot read texture: " + stbi_failure_reason());
   std::vector<uint8_t> srgb(texels, texels + size_t(w) * size_t(h) * 3);
   stbi_image_free(texels);
   return Texture(w, h, std::move(srgb));
+}
+
+Texture load_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
+  return decode_texture(read_texture(path, limits, cancel));
 }
 
 std::optional<fs::path> FileFinder::find(const fs::path& dir, const std::string& name) {

@@ -40,9 +40,22 @@ struct TextureLimits {
   uint64_t max_total_bytes = uint64_t(2048) << 20;
 };
 
-// Decodes any image stb_image reads (PNG, JPEG, ...) after reading its header: throws InputError
-// naming the file when it cannot be read, is not a regular file, or is larger than
-// `limits.max_texels`. Cancelled when `cancel` is set while reading.
+// A texture file read but not decoded: its bytes and the size its header gives.
+struct EncodedTexture {
+  std::string name;
+  std::string bytes;
+  int width = 0, height = 0;
+  uint64_t decoded_bytes() const { return uint64_t(width) * uint64_t(height) * 3; }
+};
+
+// Reads any image stb_image reads (PNG, JPEG, ...) and its header: throws InputError naming the
+// file when it cannot be read, is not a regular file, or is larger than `limits.max_texels`.
+// Cancelled when `cancel` is set while reading.
+EncodedTexture read_texture(const std::filesystem::path& path, const TextureLimits& limits = {},
+                            CancelFlag cancel = nullptr);
+// Decodes what read_texture() read; throws InputError naming the file.
+Texture decode_texture(const EncodedTexture& encoded);
+// Both.
 Texture load_texture(const std::filesystem::path& path, const TextureLimits& limits = {}, CancelFlag cancel = nullptr);
 
 // The file `name` (relative, as an MTL writes it) under `dir`: the exact path if it exists (of
