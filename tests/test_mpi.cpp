@@ -382,8 +382,7 @@ TEST_F(MpiRender, AStragglersTilesCountOnce) {
   const auto r = test::run_tracer(common + " -o " + dir_ + "/ref.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string image = dir_ + "/x.exr";
-  const auto m =
-      stall_one_rank(mpirun(3) + kMpiExe + common + " --rank-timeout 1 -o " + image, dir_, 1, image, 6.0);
+  const auto m = stall_one_rank(mpirun(3) + kMpiExe + common + " --rank-timeout 1 -o " + image, dir_, 1, image, 6.0);
   EXPECT_EQ(read_file(image), read_file(dir_ + "/ref.exr"));
   // Whether 6 s is past the bound depends on how slow the tiles were (8x the slowest): on a loaded
   // machine the pause may go unnoticed. The image is the same whichever way.
