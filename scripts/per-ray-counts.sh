@@ -5,17 +5,22 @@
 # of one ray, loading and building cancelled out. The caches simulated are this machine's: L1D
 # 48 KiB 12-way and a 1 MiB 16-way last level (its L2). Valgrind has no AVX-512: Highway's
 # kernels run their AVX2 target under it.
-#   scripts/per-ray-counts.sh [--sizes 128,256] -- build/release/tracer render SCENE [flags...]
-# Flags must not include --width, --height, -o or --stats-json; add --threads 1.
+#   scripts/per-ray-counts.sh [--sizes 128,256] [--top N] -- build/release/tracer render SCENE [flags...]
+# Flags must not include --width, --height, -o or --stats-json; add --threads 1. --top N also
+# lists the N functions that cost most per ray (cg_diff of the two runs).
 set -euo pipefail
 sizes=128,256
-if [[ ${1:-} == --sizes ]]; then
-  sizes=$2
+top=0
+while [[ ${1:-} == --sizes || ${1:-} == --top ]]; do
+  case $1 in
+    --sizes) sizes=$2 ;;
+    --top) top=$2 ;;
+  esac
   shift 2
-fi
+done
 [[ ${1:-} == -- ]] && shift
 if (($# < 2)); then
-  sed -n '2,9p' "$0" >&2
+  sed -n '2,10p' "$0" >&2
   exit 2
 fi
 command -v valgrind >/dev/null || { echo "per-ray-counts: needs valgrind (apt-get install valgrind)" >&2; exit 1; }
@@ -58,3 +63,19 @@ awk -v ir1="$ir1" -v ir2="$ir2" -v d11="$d11" -v d12="$d12" -v dl1="$dl1" -v dl2
      printf "per ray: %.0f instructions, %.2f L1D read misses, %.3f last-level read misses\n",
             (ir2 - ir1) / rays, (d12 - d11) / rays, (dl2 - dl1) / rays
    }'
+
+if ((top > 0)); then
+  # Per function: the larger run's counts minus the smaller's, over the extra rays.
+  rays=$((r2 - r1))
+  cg_diff "$work/cg-$small" "$work/cg-$large" > "$work/cg-diff" 2>/dev/null
+  echo "functions, per ray (instructions, L1D read misses, last-level read misses):"
+  cg_annotate --show=Ir,D1mr,DLmr --sort=D1mr --threshold=0 --auto=no "$work/cg-diff" 2>/dev/null |
+    awk -v rays="$rays" -v top="$top" '
+      /^-+$/ { dashes++; next }
+      dashes >= 4 && NF >= 4 && $1 ~ /^-?[0-9,]+$/ && shown < top {
+        ir = $1; d1 = $2; dl = $3; gsub(",", "", ir); gsub(",", "", d1); gsub(",", "", dl)
+        name = ""; for (i = 4; i <= NF; ++i) name = name " " $i
+        if (length(name) > 90) name = substr(name, 1, 90) "..."
+        printf "%8.1f %7.3f %7.4f %s\n", ir / rays, d1 / rays, dl / rays, name; shown++
+      }'
+fi

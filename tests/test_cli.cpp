@@ -110,7 +110,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render -m ''", 2, "--scene: an empty file name"},
       {"render --view tri --views BADVIEWS", 1,
        "badviews.tsv:2: look: expected x,y,z (three finite numbers), got '0,0'"},
-      {"render RANGE --view tri --views VIEWS", 2, "--view: the view names its scene"},
+      {"render RANGE --view tri --views VIEWS", 2, "--view: view 'tri' is of "},
       {"bench --scenes nope --views VIEWS", 2, "--scenes: no view called 'nope'"},
   };
   for (const CliCase& c : cases) {
@@ -220,6 +220,11 @@ TEST_F(Cli, ASceneWithoutLightsTakesItsViewFromAViewsFileBesideIt) {
   r = test::run_tracer("render --view tri --views " + dir_ + "/views.tsv -q" + flags + dir_ + "/view.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_image(dir_ + "/plain.png").rgb, read_image(dir_ + "/view.png").rgb);
+  // The view's own scene given beside --view, by another path to it: the same image.
+  r = test::run_tracer("render " + dir_ + "/../" + fs::path(dir_).filename().string() + "/ok.obj --view tri --views " +
+                       dir_ + "/views.tsv -q" + flags + dir_ + "/both.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/both.png").rgb, read_image(dir_ + "/view.png").rgb);
   r = test::run_tracer("render - -q" + flags + dir_ + "/stdin.png < " + dir_ + "/ok.obj");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(read_image(dir_ + "/stdin.png").rgb, read_image(dir_ + "/view.png").rgb);

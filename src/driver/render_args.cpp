@@ -209,9 +209,12 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
   const WarningSink silent = [](const std::string&) {};
   const WarningSink warn = quiet ? silent : WarningSink{};
   if (!a.view.empty()) {
-    if (!a.scene.empty()) throw UsageError("--view: the view names its scene; give either a scene or --view");
     const std::string path = a.views.empty() ? default_views_path() : a.views;
     const View view = find_view(load_views(path), a.view, path);
+    // The view names its scene; a scene given too must be that file (by any path to it).
+    if (!a.scene.empty() && !same_file(a.scene, view.obj)) {
+      throw UsageError("--view: view '" + a.view + "' is of " + view.obj + ", not of the scene " + a.scene);
+    }
     Scene scene = load_obj(view.obj, warn, cancel, limits);
     apply_view_light(scene, view);
     scene.camera = view.camera;
