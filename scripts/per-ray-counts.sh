@@ -72,6 +72,7 @@ if ((top > 0)); then
   cg_annotate --show=Ir,D1mr,DLmr --sort=D1mr --threshold=0 --auto=no "$work/cg-diff" 2>/dev/null |
     awk -v rays="$rays" -v top="$top" '
       /^-+$/ { dashes++; next }
+      { gsub(/\( *-?[0-9.]+%\)/, ""); $0 = $0 }  # drop the percentages cg_annotate adds
       dashes >= 4 && NF >= 4 && $1 ~ /^-?[0-9,]+$/ && shown < top {
         ir = $1; d1 = $2; dl = $3; gsub(",", "", ir); gsub(",", "", d1); gsub(",", "", dl)
         name = ""; for (i = 4; i <= NF; ++i) name = name " " $i

@@ -47,6 +47,12 @@ class Collapser {
       kids[size_t(best)] = n.index;
       kids.insert(kids.begin() + best + 1, n.index + 1);
     }
+    // Largest subtree (in triangles) first. Any-hit traversal enters the last slot first, so it
+    // tries the smallest subtrees first: few triangles spanning a box as large as their siblings'
+    // are large triangles (walls, floors), the likeliest occluders. Embree's builder orders its
+    // children the same way. On Sponza's AO rays: 29 % fewer nodes and 7x fewer L1 misses per ray
+    // (docs/bench/LOG.md).
+    std::stable_sort(kids.begin(), kids.end(), [&](uint32_t a, uint32_t b) { return count_[a] > count_[b]; });
     const auto self = static_cast<uint32_t>(out_.size());
     out_.emplace_back();
     {

@@ -261,12 +261,14 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
   StackEntry cur = start;
   for (;;) {
     if (cur.count == 0) {
-      // Any hit ends the query, so the children need no order: push them as found.
+      // Any hit ends the query, so distance does not order the children: the last slot (the
+      // smallest subtree, see wide_bvh_build.cpp) is entered first, the others popped from the
+      // last down.
       const WideNode& n = nodes[cur.child];
       uint32_t bits = TestChildren(n, node_ray, tnear, tfar, t);
       if (bits) {
-        int c = __builtin_ctz(bits);
-        for (bits &= bits - 1; bits; bits &= bits - 1) {
+        const int c = 31 - __builtin_clz(bits);
+        for (bits &= ~(1u << c); bits; bits &= bits - 1) {
           const int o = __builtin_ctz(bits);
           stack[sp++] = {n.child[o], n.count[o], 0.0f};
         }
