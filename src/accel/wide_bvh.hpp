@@ -56,25 +56,21 @@ class WideBvh {
   // Closest hits of the packet's active lanes, traversed together; hits[k] is exactly what
   // intersect(rays.ray(k), hits[k]) gives. Inactive lanes' hits are left untouched.
   void intersect_packet(const RayPacket& rays, Hit* hits) const;
-  // The lanes of rays.active whose rays, leaving scene triangle `origin` from one point (the AO
-  // rays of one shading point), are occluded; each the answer occluded() gives its ray. The
-  // search starts at the origin's leaf and walks up: at each level the ancestor's other children
-  // are tested against all the rays at once (one SIMD lane per ray), then entered ray by ray.
+  // The lanes of rays.active whose rays (up to 16 leaving one point: the AO rays of one shading
+  // point) are occluded; each the answer occluded() gives its ray. Top-down: while many rays
+  // enter a node, its children's boxes are tested against all of them at once (one SIMD lane per
+  // ray); where few do, each goes on alone from there. `origin` (the triangle they leave) is not
+  // needed by this tree; the binary BVH starts from it.
   uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const PackArray& packs() const { return packs_; }
-  // Where each node hangs: its parent node and slot, as place(parent, slot); the root has kInvalidIndex.
-  const std::vector<uint32_t>& node_places() const { return node_place_; }
-  // The node and slot of the leaf holding each scene triangle (kInvalidIndex: degenerate, in no leaf).
-  const std::vector<uint32_t>& leaf_places() const { return leaf_place_; }
-  static constexpr uint32_t place(uint32_t node, uint32_t slot) { return node * kWideWidth + slot; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const {
-    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack) +
-           (node_place_.size() + leaf_place_.size()) * sizeof(uint32_t);
+    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack);
   }
-  // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf.
+  // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf,
+  // empty slots come last.
   std::string validate() const;
   const Scene& scene() const { return *scene_; }
 
@@ -90,7 +86,6 @@ class WideBvh {
   const Scene* scene_;
   std::vector<WideNode> nodes_;
   PackArray packs_;
-  std::vector<uint32_t> node_place_, leaf_place_;
   Aabb bounds_;
 };
 

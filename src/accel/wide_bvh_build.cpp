@@ -1,5 +1,4 @@
-// Building the 8-wide BVH: the binary SAH tree collapsed into 8-wide nodes, leaves packed, and
-// where every node and leaf hangs recorded for the bundles' walk up from a leaf.
+// Building the 8-wide BVH: the binary SAH tree collapsed into 8-wide nodes, leaves packed.
 #include <algorithm>
 #include <vector>
 
@@ -138,20 +137,6 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Ex
   collapser.collapse(0);
   exec.run([&] { collapser.fill_packs(exec); });
   bounds_ = Aabb{binary.nodes[0].lo, binary.nodes[0].hi};
-  // Where every node and every triangle's leaf hangs, for searches that start at a leaf.
-  node_place_.assign(nodes_.size(), kInvalidIndex);
-  leaf_place_.assign(scene.size(), kInvalidIndex);
-  for (uint32_t w = 0; w < nodes_.size(); ++w) {
-    const WideNode& n = nodes_[w];
-    for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
-      if (n.count[c] > 0) {
-        const TrianglePack& pack = packs_[n.child[c]];
-        for (uint32_t lane = 0; lane < n.count[c]; ++lane) leaf_place_[pack.id[lane]] = place(w, c);
-      } else if (n.child[c] != 0) {  // child 0 is the root: an empty slot
-        node_place_[n.child[c]] = place(w, c);
-      }
-    }
-  }
 }
 
 }  // namespace tracer

@@ -1,5 +1,5 @@
-// The 8-wide BVH's AO bundles: up to 16 rays leaving one point start at the leaf of the triangle
-// they leave and walk up once for all of them (README, "--packets"), compiled once per SIMD target.
+// The 8-wide BVH's AO bundles: up to 16 rays leaving one point searched top-down together while
+// many of them enter the same nodes (README, "--packets"), compiled once per SIMD target.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "accel/wide_bvh_bundles.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -53,20 +53,11 @@ HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t coun
   return found;
 }
 
-uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t origin) {
+uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t /*origin*/) {
   const auto& nodes = bvh.nodes();
   if (nodes.empty() || rays.active == 0) return 0;
-  const auto& leaves = bvh.leaf_places();
-  if (origin >= leaves.size() || leaves[origin] == kInvalidIndex) {
-    uint32_t occluded = 0;  // no leaf to start from: each ray from the root
-    for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
-      const int k = __builtin_ctz(bits);
-      if (OccludedFromRoot(bvh, rays.ray(k))) occluded |= 1u << k;
-    }
-    return occluded;
-  }
   const BundleState st(rays);
-  // Rays that miss the tree's box are answered at once, as from the root.
+  // Rays that miss the tree's box are answered at once.
   const float lo[3] = {bvh.bounds().lo.x, bvh.bounds().lo.y, bvh.bounds().lo.z};
   const float hi[3] = {bvh.bounds().hi.x, bvh.bounds().hi.y, bvh.bounds().hi.z};
   uint32_t active = TestBundleBox(lo, hi, st, rays.active);
@@ -75,56 +66,39 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
   const TrianglePack* packs = bvh.packs().data();
   uint32_t occluded = 0;
 
-  // Subtrees to search, each with the lanes that enter it: many lanes go on together, one SIMD
-  // lane per ray; a few go on one ray at a time.
+  // Subtrees to search, each with the lanes that enter it. Children are pushed in slot order, so
+  // the last slot (the smallest subtree) is searched first, as in single-ray any-hit.
   struct Entry {
     uint32_t child, count, lanes;
   };
   Entry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
-  const auto push_children = [&](const WideNode& n, uint32_t skip, uint32_t lanes) {
-    for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
-      if (c == skip || (n.child[c] == 0 && n.count[c] == 0)) continue;  // the way we came, or an empty slot
-      const float clo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, chi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
-      const uint32_t entering = TestBundleBox(clo, chi, st, lanes);
-      if (entering) stack[sp++] = {n.child[c], n.count[c], entering};
-    }
-  };
-  const auto search = [&] {
-    while (sp > 0) {
-      const Entry e = stack[--sp];
-      const uint32_t lanes = e.lanes & active;
-      if (lanes == 0) continue;
-      uint32_t found = 0;
-      if (std::popcount(lanes) < kBundleMinLanes) {
-        for (uint32_t bits = lanes; bits; bits &= bits - 1) {
-          const int k = __builtin_ctz(bits);
-          if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f}))
-            found |= 1u << k;
-        }
-      } else if (e.count > 0) {
-        found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
-      } else {
-        push_children(nodes[e.child], kWideWidth, lanes);
+  stack[sp++] = {0, 0, active};
+  while (sp > 0) {
+    const Entry e = stack[--sp];
+    const uint32_t lanes = e.lanes & active;
+    if (lanes == 0) continue;
+    uint32_t found = 0;
+    if (std::popcount(lanes) < kBundleMinLanes) {
+      for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f}))
+          found |= 1u << k;
       }
-      occluded |= found;
-      active &= ~found;
-      if (active == 0) return;
+    } else if (e.count > 0) {
+      found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
+    } else {
+      const WideNode& n = nodes[e.child];
+      for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
+        if (n.child[c] == 0 && n.count[c] == 0) break;  // empty slots come last
+        const float clo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, chi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
+        const uint32_t entering = TestBundleBox(clo, chi, st, lanes);
+        if (entering) stack[sp++] = {n.child[c], n.count[c], entering};
+      }
     }
-  };
-  // The origin's leaf, then each ancestor's other children on the way up: every node off that
-  // path lies below exactly one of them, so together they cover the tree.
-  uint32_t where = leaves[origin];
-  uint32_t node = where / kWideWidth, slot = where % kWideWidth;
-  stack[sp++] = {nodes[node].child[slot], nodes[node].count[slot], active};
-  search();
-  while (active != 0) {
-    push_children(nodes[node], slot, active);
-    search();
-    where = bvh.node_places()[node];
-    if (where == kInvalidIndex) break;
-    node = where / kWideWidth;
-    slot = where % kWideWidth;
+    occluded |= found;
+    active &= ~found;
+    if (active == 0) break;
   }
   return occluded;
 }
