@@ -8,6 +8,9 @@
 #include <mutex>
 
 #include "accel/accelerator.hpp"
+#ifdef TRACER_HAVE_EMBREE
+#include "accel/embree_accel.hpp"
+#endif
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
@@ -338,6 +341,52 @@ TEST(BvhBuild, CancelFlagStopsEveryBuilderAndEmbree) {
   o.bvh.cancel = &cancel;
   EXPECT_EQ(std::get<Bvh>(*build_accelerator(scene, o).impl).validate(), "");
 }
+
+
+#ifdef TRACER_HAVE_EMBREE
+TEST(BvhAgreement, EmbreePacketsWithUnusedLanesOnItsAvx2Kernels) {
+  // Without AVX-512 Embree has no 16-wide kernels: rtcOccluded16 and rtcIntersect16 then trace all
+  // sixteen lanes, whatever the valid mask says. Packets with a few lanes, through its AVX2 code,
+  // must give each ray its single-ray answer (and not stop on Embree's assertion of a bad lane).
+  const Scene scene = make_cornell_box();
+  const EmbreeAccel embree(scene, nullptr, "isa=avx2");
+  const Vec3 org = scene.bounds.center();
+  for (const uint32_t active : {0x1u, 0x8421u, 0x7ffeu, 0xffffu}) {
+    SCOPED_TRACE(active);
+    RayBundle bundle;
+    RayPacket packet;
+    for (int k = 0; k < kPacketSize; ++k) {
+      if (!((active >> k) & 1u)) continue;
+      const float a = 0.39f * float(k);
+      const Vec3 dir = normalize(Vec3{std::cos(a), 0.3f * float(k % 5) - 0.6f, std::sin(a)});
+      bundle.set_direction(k, dir);
+      Ray r;
+      r.org = org;
+      r.dir = dir;
+      packet.set(k, r);
+    }
+    bundle.org = org;
+    bundle.tfar = 0.3f;  // some lanes reach a wall, some do not
+    uint32_t expected_bundle = 0, expected_packet = 0;
+    for (int k = 0; k < kPacketSize; ++k) {
+      if (!((active >> k) & 1u)) continue;
+      if (embree.occluded(bundle.ray(k))) expected_bundle |= 1u << k;
+      if (embree.occluded(packet.ray(k))) expected_packet |= 1u << k;
+    }
+    EXPECT_EQ(embree.occluded_bundle_from(bundle, 0), expected_bundle);
+    EXPECT_EQ(embree.occluded_packet(packet), expected_packet);
+    Hit hits[kPacketSize];
+    embree.intersect_packet(packet, hits);
+    for (int k = 0; k < kPacketSize; ++k) {
+      if (!((active >> k) & 1u)) continue;
+      Hit single;
+      EXPECT_EQ(embree.intersect(packet.ray(k), single), hits[k].valid()) << k;
+      EXPECT_EQ(hits[k].primID, single.primID) << k;
+      EXPECT_EQ(hits[k].t, single.t) << k;
+    }
+  }
+}
+#endif
 
 }  // namespace
 }  // namespace tracer

@@ -1,5 +1,6 @@
 #include "accel/embree_accel.hpp"
 
+#include <limits>
 #include <string>
 
 #include "base/errors.hpp"
@@ -15,8 +16,8 @@ bool EmbreeAccel::monitor(void* user, ssize_t bytes, bool /*post*/) {
   return true;
 }
 
-EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel) : scene_(&scene) {
-  device_ = rtcNewDevice(nullptr);
+EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel, const char* device_config) : scene_(&scene) {
+  device_ = rtcNewDevice(device_config);
   if (!device_)
     throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
@@ -135,6 +136,34 @@ void fill_ray16(RTCRay16& r, int k, const Ray& ray) {
   r.flags[k] = 0;
 }
 
+// Every lane of a 16-wide call holds a valid ray: where Embree has no 16-wide kernels (CPUs
+// without AVX-512) rtcOccluded16 and rtcIntersect16 hand all sixteen lanes to its ray-stream
+// path, which ignores the valid mask, and its assertions stop the process on a lane of garbage.
+// Lanes without a ray get this one, which Embree skips as already finished (tfar < 0).
+void fill_unused_ray16(RTCRay16& r, int k) {
+  r.org_x[k] = r.org_y[k] = r.org_z[k] = 0.0f;
+  r.dir_x[k] = r.dir_y[k] = 0.0f;
+  r.dir_z[k] = 1.0f;
+  r.tnear[k] = 0.0f;
+  r.tfar[k] = -std::numeric_limits<float>::infinity();
+  r.time[k] = 0.0f;
+  r.mask[k] = 0;
+  r.id[k] = unsigned(k);
+  r.flags[k] = 0;
+}
+
+// Lane k of `r` from rays(k) where `active` has it, else unused.
+template <class RayOf>
+void fill_rays16(RTCRay16& r, uint32_t active, const RayOf& rays) {
+  for (int k = 0; k < kPacketSize; ++k) {
+    if ((active >> k) & 1u) {
+      fill_ray16(r, k, rays(k));
+    } else {
+      fill_unused_ray16(r, k);
+    }
+  }
+}
+
 uint32_t occluded16(RTCScene scene, uint32_t active, RTCRay16& r, RTCIntersectContextFlags flags) {
   alignas(64) int valid[kPacketSize];
   valid_lanes(active, valid);
@@ -156,9 +185,8 @@ void EmbreeAccel::intersect_packet(const RayPacket& rays, Hit* hits) const {
   alignas(64) RTCRayHit16 rh;
   alignas(64) int valid[kPacketSize];
   valid_lanes(rays.active, valid);
-  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
-    fill_ray16(rh.ray, k, rays.ray(k));
+  fill_rays16(rh.ray, rays.active, [&](int k) { return rays.ray(k); });
+  for (int k = 0; k < kPacketSize; ++k) {
     rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
@@ -182,19 +210,13 @@ void EmbreeAccel::intersect_packet(const RayPacket& rays, Hit* hits) const {
 
 uint32_t EmbreeAccel::occluded_packet(const RayPacket& rays) const {
   alignas(64) RTCRay16 r;
-  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
-    fill_ray16(r, k, rays.ray(k));
-  }
+  fill_rays16(r, rays.active, [&](int k) { return rays.ray(k); });
   return occluded16(rtc_scene_, rays.active, r, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
 }
 
 uint32_t EmbreeAccel::occluded_bundle_from(const RayBundle& rays, uint32_t) const {
   alignas(64) RTCRay16 r;
-  for (uint32_t bits = rays.active; bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
-    fill_ray16(r, k, rays.ray(k));
-  }
+  fill_rays16(r, rays.active, [&](int k) { return rays.ray(k); });
   return occluded16(rtc_scene_, rays.active, r, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
 }
 

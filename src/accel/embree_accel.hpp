@@ -17,7 +17,8 @@ namespace tracer {
 
 class EmbreeAccel {
  public:
-  explicit EmbreeAccel(const Scene& scene, CancelFlag cancel = nullptr);
+  // `device_config`: rtcNewDevice's configuration string (e.g. "isa=avx2"; null: Embree's choice).
+  explicit EmbreeAccel(const Scene& scene, CancelFlag cancel = nullptr, const char* device_config = nullptr);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
