@@ -230,11 +230,13 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
     const std::optional<View> view = view_of_scene_file(a.scene, &problem);
     if (!problem.empty() && !quiet) std::cerr << "tracer: warning: " << problem << " (its views are not used)\n";
     if (view) {
-      if (a.lights.empty()) apply_view_light(scene, *view);
+      // Its light unless another is given or --no-scene-lights drops it (add_lights, below).
+      const bool view_light = a.lights.empty() && !a.no_scene_lights;
+      if (view_light) apply_view_light(scene, *view);
       scene.camera = view->camera;
       if (!quiet) {
         std::cerr << "tracer: note: " << a.scene << " has no light of its own: using its view '" << view->name
-                  << (a.lights.empty() ? "' (camera and light)\n" : "' (camera)\n");
+                  << (view_light ? "' (camera and light)\n" : "' (camera)\n");
       }
     }
   }
