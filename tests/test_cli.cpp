@@ -397,6 +397,17 @@ TEST_F(Cli, RendersPngPpmAndStats) {
   const std::string text((std::istreambuf_iterator<char>(json)), {});
   EXPECT_NE(text.find("\"primary\": 192"), std::string::npos) << text;
   EXPECT_NE(text.find("\"mrays_per_s\""), std::string::npos);
+  // The load split into its phases, which add up to no more than the whole.
+  const nlohmann::json stats = nlohmann::json::parse(text);
+  double phases = 0.0;
+  for (const char* phase : {"read", "parse", "textures", "assembly"}) {
+    ASSERT_TRUE(stats["load_phases_ms"].contains(phase)) << text;
+    EXPECT_GE(stats["load_phases_ms"][phase].get<double>(), 0.0) << phase;
+    phases += stats["load_phases_ms"][phase].get<double>();
+  }
+  EXPECT_LE(phases, stats["load_ms"].get<double>());
+  EXPECT_NE(r.output.find("load ") , std::string::npos);
+  EXPECT_NE(r.output.find("(read "), std::string::npos) << r.output;
   r = test::run_tracer("render " + scene + " -q --integrator ao --width 16 --height 12 --ao 2 -o " + dir_ + "/a.ppm");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Image8 ppm = read_image(dir_ + "/a.ppm");

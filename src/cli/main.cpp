@@ -44,7 +44,8 @@ int cmd_render(const RenderArgs& args) {
   }
 
   const auto t_load = std::chrono::steady_clock::now();
-  const Scene scene = load_scene(args.scene, args.quiet, cancel);
+  LoadPhases load_phases;
+  const Scene scene = load_scene(args.scene, args.quiet, cancel, &load_phases);
   const double load_ms = ms_since(t_load);
   check_outputs_against_inputs(args);
   const CameraSpec camera = camera_for(scene, args);
@@ -93,7 +94,8 @@ int cmd_render(const RenderArgs& args) {
   const int checkpoints = r.checkpoints;
   progress.stop();
   const double render_ms = ms_since(t_render);
-  nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load());
+  nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load(),
+                                       args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &load_phases);
   stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);
   if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");

@@ -195,7 +195,7 @@ void add_lights(Scene& scene, const SceneArgs& a) {
 
 }  // namespace
 
-Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
+Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* phases) {
   check_range("--max-input-mib", (long long)a.max_input_mib, 1, 1 << 20);
   check_range("--max-texture-mib", (long long)a.max_texture_mib, 1, 1 << 20);
   LoadLimits limits;
@@ -215,13 +215,14 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel) {
     if (!a.scene.empty() && !same_file(a.scene, view.obj)) {
       throw UsageError("--view: view '" + a.view + "' is of " + view.obj + ", not of the scene " + a.scene);
     }
-    Scene scene = load_obj(view.obj, warn, cancel, limits);
+    Scene scene = load_obj(view.obj, warn, cancel, limits, phases);
     apply_view_light(scene, view);
     scene.camera = view.camera;
     add_lights(scene, a);
     return scene;
   }
-  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits);
+  Scene scene =
+      a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
   // A scene with no light of its own (Sponza, Sibenik, the Bunny) that a views.tsv beside it
   // knows: its view's camera, and its light unless --light gives one, so a plain render shows it
   // as the views mean it (from inside, lit) rather than framed from outside in the dark.

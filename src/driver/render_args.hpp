@@ -67,7 +67,7 @@ void add_render_options(CLI::App& app, RenderArgs& args);
 
 // Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.
 // "-" reads the OBJ from standard input. `quiet` drops the loader's warnings.
-Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr);
+Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr, LoadPhases* phases = nullptr);
 // Two paths name the same file: the same inode if both exist, else the same absolute path.
 bool same_file(const std::string& a, const std::string& b);
 // -o and --stats-json: known formats, writable, and neither of them the input scene or each other.

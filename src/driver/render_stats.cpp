@@ -19,9 +19,9 @@ double peak_rss_mib() {
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
-                            const RayCounts& rays) {
+                            const RayCounts& rays, const LoadPhases* load_phases) {
   const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
-  return {{"scene", scene.source},
+  nlohmann::json j = {{"scene", scene.source},
           {"triangles", scene.size()},
           {"width", settings.width},
           {"height", settings.height},
@@ -48,6 +48,13 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
           {"accel_bytes", accel.memory_bytes()},
           {"peak_rss_mib", peak_rss_mib()},
           {"output", args.output}};
+  if (load_phases) {
+    j["load_phases_ms"] = {{"read", load_phases->read_ms},
+                           {"parse", load_phases->parse_ms},
+                           {"textures", load_phases->textures_ms},
+                           {"assembly", load_phases->assembly_ms}};
+  }
+  return j;
 }
 
 void print_stats(const nlohmann::json& j, const Accelerator& accel) {
@@ -74,7 +81,13 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
                 st->nodes, st->leaves, st->avg_leaf_size, st->max_leaf_size, st->max_depth, st->sah_cost);
   }
   std::printf("scheduler    %s, %d threads\n", str("sched").c_str(), j["threads"].get<int>());
-  std::printf("load         %10.2f ms\n", j["load_ms"].get<double>());
+  std::printf("load         %10.2f ms", j["load_ms"].get<double>());
+  if (j.contains("load_phases_ms")) {
+    const auto& p = j["load_phases_ms"];
+    std::printf("  (read %.2f, parse %.2f, textures %.2f, assembly %.2f)", p["read"].get<double>(),
+                p["parse"].get<double>(), p["textures"].get<double>(), p["assembly"].get<double>());
+  }
+  std::printf("\n");
   std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
   std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
   const auto& r = j["rays"];

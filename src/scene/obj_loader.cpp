@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -38,6 +39,11 @@ constexpr size_t kCancelStride = 1 << 16;
 
 // Reads one number of an OBJ line. Accepts what tinyobjloader reads as a number (a leading '+',
 // values that underflow to zero) and rejects what it would silently turn into 0 or infinity.
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
 float parse_coordinate(std::string_view tok, const std::string& name, size_t line) {
   std::string_view digits = tok;
   if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
@@ -310,7 +316,7 @@ Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, War
 // Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
 // finite and within range, every face index inside the vertex array, material ids in range.
 Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings,
-                  const LoadLimits& limits, CancelFlag cancel) {
+                  const LoadLimits& limits, CancelFlag cancel, LoadPhases& phases) {
   const tinyobj::attrib_t& attrib = parsed.attrib;
   Scene scene;
   scene.source = name;
@@ -323,6 +329,7 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     }
   }
 
+  const auto textures_start = Clock::now();
   // map_Kd textures, each file read and decoded once; one warning for all that are missing or
   // unreadable. The other maps (bump, Ks, Ka, alpha) are not used by any integrator, so not read.
   // 1. Which file each material names (sequential: directory listings are cached).
@@ -379,6 +386,7 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     texture_of[k] = uint32_t(scene.textures.size());
     scene.textures.push_back(std::move(*decoded[k]));
   }
+  phases.textures_ms = ms_since(textures_start);
   size_t missing_textures = 0;
   std::string first_missing;
   for (size_t i = 0; i < parsed.materials.size(); ++i) {
@@ -487,29 +495,39 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
 void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
 Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
-           const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits) {
+           const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits, LoadPhases* phases) {
   const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
   strip_bom(text);
   WarningLog warnings;
+  LoadPhases local;
+  LoadPhases& ph = phases ? *phases : local;
+  const auto parse_start = Clock::now();
   const Parsed parsed = parse(text, name, mtl, warnings, cancel);
-  Scene scene = build_scene(parsed, name, base_dir, warnings, limits, cancel);
+  ph.parse_ms = ms_since(parse_start);
+  const auto build_start = Clock::now();
+  Scene scene = build_scene(parsed, name, base_dir, warnings, limits, cancel, ph);
+  ph.assembly_ms = ms_since(build_start) - ph.textures_ms;
   warnings.flush(name, warn);
   return scene;
 }
 
 }  // namespace
 
-Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits) {
+Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits,
+               LoadPhases* phases) {
+  const auto read_start = Clock::now();
   std::string text = read_input(path, cancel, limits.max_obj_bytes);
+  if (phases) phases->read_ms = ms_since(read_start);
   const fs::path base_dir = path == "-" ? fs::path() : fs::path(path).parent_path();
   return load(text, path == "-" ? std::string("<stdin>") : path, base_dir,
-              MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir, cancel), warn, cancel, limits);
+              MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir, cancel), warn, cancel, limits,
+              phases);
 }
 
 Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
                            const WarningSink& warn) {
   std::string text = obj_text;
-  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr, LoadLimits{});
+  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr, LoadLimits{}, nullptr);
 }
 
 }  // namespace tracer

@@ -37,8 +37,14 @@ struct LoadLimits {
   ForEach for_each = sequential_for_each;
 };
 
+// Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its
+// MTL, reading and decoding the textures, and assembling the scene's arrays.
+struct LoadPhases {
+  double read_ms = 0.0, parse_ms = 0.0, textures_ms = 0.0, assembly_ms = 0.0;
+};
+
 Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr,
-               const LoadLimits& limits = {});
+               const LoadLimits& limits = {}, LoadPhases* phases = nullptr);
 
 // The same from memory (fuzzing, tests); `name` stands for the file in messages, and `mtl_text`
 // serves every `mtllib` the OBJ names.
