@@ -342,7 +342,6 @@ TEST(BvhBuild, CancelFlagStopsEveryBuilderAndEmbree) {
   EXPECT_EQ(std::get<Bvh>(*build_accelerator(scene, o).impl).validate(), "");
 }
 
-
 #ifdef TRACER_HAVE_EMBREE
 TEST(BvhAgreement, EmbreePacketsWithUnusedLanesOnItsAvx2Kernels) {
   // Without AVX-512 Embree has no 16-wide kernels: rtcOccluded16 and rtcIntersect16 then trace all

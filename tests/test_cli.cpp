@@ -218,8 +218,10 @@ TEST_F(Cli, ASceneWithoutLightsTakesItsViewFromAViewsFileBesideIt) {
   EXPECT_NE(r.output.find("has no light of its own: using its view 'tri' (camera and light)"), std::string::npos)
       << r.output;
   // --no-scene-lights drops the view's light too, and the note says only the camera is used.
-  r = test::run_tracer("render " + dir_ + "/ok.obj --no-scene-lights --env 1,1,1 --integrator path --spp 1 "
-                       "--width 8 --height 8 -o " + dir_ + "/nolight.png");
+  r = test::run_tracer("render " + dir_ +
+                       "/ok.obj --no-scene-lights --env 1,1,1 --integrator path --spp 1 "
+                       "--width 8 --height 8 -o " +
+                       dir_ + "/nolight.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("using its view 'tri' (camera)\n"), std::string::npos) << r.output;
   r = test::run_tracer("render --view tri --views " + dir_ + "/views.tsv -q" + flags + dir_ + "/view.png");
@@ -406,7 +408,7 @@ TEST_F(Cli, RendersPngPpmAndStats) {
     phases += stats["load_phases_ms"][phase].get<double>();
   }
   EXPECT_LE(phases, stats["load_ms"].get<double>());
-  EXPECT_NE(r.output.find("load ") , std::string::npos);
+  EXPECT_NE(r.output.find("load "), std::string::npos);
   EXPECT_NE(r.output.find("(read "), std::string::npos) << r.output;
   r = test::run_tracer("render " + scene + " -q --integrator ao --width 16 --height 12 --ao 2 -o " + dir_ + "/a.ppm");
   ASSERT_EQ(r.exit_code, 0) << r.output;

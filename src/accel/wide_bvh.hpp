@@ -66,9 +66,7 @@ class WideBvh {
   const std::vector<WideNode>& nodes() const { return nodes_; }
   const PackArray& packs() const { return packs_; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
-  size_t memory_bytes() const {
-    return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack);
-  }
+  size_t memory_bytes() const { return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack); }
   // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf,
   // empty slots come last.
   std::string validate() const;

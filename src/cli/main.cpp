@@ -95,7 +95,7 @@ int cmd_render(const RenderArgs& args) {
   progress.stop();
   const double render_ms = ms_since(t_render);
   nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load(),
-                                       args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &load_phases);
+                                      args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &load_phases);
   stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);
   if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");

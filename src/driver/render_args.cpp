@@ -221,8 +221,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     add_lights(scene, a);
     return scene;
   }
-  Scene scene =
-      a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
+  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
   // A scene with no light of its own (Sponza, Sibenik, the Bunny) that a views.tsv beside it
   // knows: its view's camera, and its light unless --light gives one, so a plain render shows it
   // as the views mean it (from inside, lit) rather than framed from outside in the dark.
