@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -157,50 +158,101 @@ class MtlSource : public tinyobj::MaterialReader {
   }
   static MtlSource from_text(std::string text) { return MtlSource({}, std::move(text), true, nullptr); }
 
+  // tinyobjloader's callback for each `mtllib` name: what read() gives, from the cache when
+  // prefetch() has read that name already. A malformed MTL (or one that never ends) throws here,
+  // when the parse reaches its `mtllib` line, as if it had been read just now.
   bool operator()(const std::string& mtl_name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* material_map, std::string* warn, std::string*) override {
-    std::string text;
-    std::string name = "<mtl>";
-    if (in_memory_) {
-      text = text_;
-    } else {
-      const fs::path path = dir_ / mtl_name;
-      name = path.string();
-      try {
-        text = read_input(name, cancel_, kMaxMtlBytes);
-      } catch (const InputTooLarge&) {
-        throw;  // a file that never ends is an error, not a missing material library
-      } catch (const InputError& e) {
-        if (warn) *warn += std::string(e.what()) + "\n";
-        return false;
-      }
+    const auto cached = cache_.find(mtl_name);
+    const MtlRead r = cached != cache_.end() ? cached->second : read(mtl_name);
+    if (r.error) std::rethrow_exception(r.error);
+    if (!r.ok) {
+      if (warn) *warn += r.warn;
+      return false;
     }
-    strip_bom(text);
-    for (const MtlMaterial& m : parse_mtl(text, name, cancel_)) {
-      tinyobj::material_t t{};  // zeroed: its texture options have no initialisers
-      t.name = m.name;
-      for (int i = 0; i < 3; ++i) {
-        t.ambient[i] = m.ka[i];
-        t.diffuse[i] = m.kd[i];
-        t.specular[i] = m.ks[i];
-        t.emission[i] = m.ke[i];
-        t.transmittance[i] = m.tf[i];
-      }
-      t.shininess = m.ns;
-      t.ior = m.ni;
-      t.dissolve = m.dissolve;
-      t.illum = m.illum;
-      t.diffuse_texname = m.diffuse_map;
-      t.bump_texname = m.bump_map;
+    for (const tinyobj::material_t& t : r.materials) {
       material_map->insert({t.name, int(materials->size())});  // the first of a name wins
-      materials->push_back(std::move(t));
+      materials->push_back(t);
     }
     return true;
+  }
+
+  // Reads the MTL files of the OBJ's `mtllib` statements (each a list of names, of which the first
+  // that reads is used, as tinyobjloader does) before the parse, and returns the diffuse texture
+  // names of the materials they will give, in order: the textures can then be read while the
+  // geometry is parsed. A name split differently from tinyobjloader's is read again by it, and the
+  // prediction is checked against what the parse gives (load()), so it only ever saves time.
+  std::vector<std::string> prefetch(const std::vector<std::vector<std::string>>& statements) {
+    std::vector<std::string> texnames;
+    for (const auto& names : statements) {
+      for (const std::string& n : names) {
+        const MtlRead& r = cache_.try_emplace(n, read(n)).first->second;
+        if (r.error) return texnames;  // the parse stops there
+        if (!r.ok) continue;
+        for (const tinyobj::material_t& t : r.materials) texnames.push_back(t.diffuse_texname);
+        break;
+      }
+    }
+    return texnames;
   }
 
  private:
   // An MTL file is text of a few kilobytes; past this it is not one (/dev/zero, a runaway pipe).
   static constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;
+
+  // One `mtllib` name read: its materials, or why not (a warning when it cannot be opened, an
+  // error to throw when it is malformed, too large, or the read was cancelled).
+  struct MtlRead {
+    bool ok = false;
+    std::string warn;
+    std::vector<tinyobj::material_t> materials;
+    std::exception_ptr error;
+  };
+
+  MtlRead read(const std::string& mtl_name) const {
+    MtlRead r;
+    try {
+      std::string text;
+      std::string name = "<mtl>";
+      if (in_memory_) {
+        text = text_;
+      } else {
+        const fs::path path = dir_ / mtl_name;
+        name = path.string();
+        try {
+          text = read_input(name, cancel_, kMaxMtlBytes);
+        } catch (const InputTooLarge&) {
+          throw;  // a file that never ends is an error, not a missing material library
+        } catch (const InputError& e) {
+          r.warn = std::string(e.what()) + "\n";
+          return r;
+        }
+      }
+      strip_bom(text);
+      for (const MtlMaterial& m : parse_mtl(text, name, cancel_)) {
+        tinyobj::material_t t{};  // zeroed: its texture options have no initialisers
+        t.name = m.name;
+        for (int i = 0; i < 3; ++i) {
+          t.ambient[i] = m.ka[i];
+          t.diffuse[i] = m.kd[i];
+          t.specular[i] = m.ks[i];
+          t.emission[i] = m.ke[i];
+          t.transmittance[i] = m.tf[i];
+        }
+        t.shininess = m.ns;
+        t.ior = m.ni;
+        t.dissolve = m.dissolve;
+        t.illum = m.illum;
+        t.diffuse_texname = m.diffuse_map;
+        t.bump_texname = m.bump_map;
+        r.materials.push_back(std::move(t));
+      }
+      r.ok = true;
+    } catch (...) {
+      r.error = std::current_exception();
+    }
+    return r;
+  }
 
   MtlSource(fs::path dir, std::string text, bool in_memory, CancelFlag cancel)
       : dir_(std::move(dir)), text_(std::move(text)), in_memory_(in_memory), cancel_(cancel) {}
@@ -208,7 +260,26 @@ class MtlSource : public tinyobj::MaterialReader {
   std::string text_;
   bool in_memory_;
   CancelFlag cancel_;
+  std::map<std::string, MtlRead> cache_;
 };
+
+// The names of each `mtllib` statement, in file order, split at blanks (tinyobjloader also honours
+// backslash escapes; such a name is then simply not prefetched).
+std::vector<std::vector<std::string>> mtllib_statements(std::string_view text) {
+  std::vector<std::vector<std::string>> statements;
+  for (size_t at = text.find("mtllib"); at != std::string_view::npos; at = text.find("mtllib", at + 6)) {
+    size_t line_start = at;
+    while (line_start > 0 && (text[line_start - 1] == ' ' || text[line_start - 1] == '\t')) --line_start;
+    if (line_start > 0 && text[line_start - 1] != '\n' && text[line_start - 1] != '\r') continue;
+    if (at + 6 >= text.size() || (text[at + 6] != ' ' && text[at + 6] != '\t')) continue;
+    size_t end = text.find_first_of("\r\n", at);
+    std::string_view rest = text.substr(at + 6, (end == std::string_view::npos ? text.size() : end) - at - 6);
+    std::vector<std::string> names;
+    for (std::string_view tok = next_token(rest); !tok.empty(); tok = next_token(rest)) names.emplace_back(tok);
+    if (!names.empty()) statements.push_back(std::move(names));
+  }
+  return statements;
+}
 
 // Groups warnings by kind (the text with its quoted names and numbers left out), so 80,000
 // undefined material names make one line with a count and the first place, not 80,000 lines.
@@ -313,10 +384,82 @@ Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, War
   return p;
 }
 
+// The map_Kd textures of a list of materials (their diffuse texture names, in material order),
+// each file read and decoded once. The other maps (bump, Ks, Ka, alpha) are not used by any
+// integrator, so not read.
+struct MaterialTextures {
+  std::vector<std::string> texnames;             // what this was made for
+  std::vector<std::string> problem;              // per material: why its texture is not used
+  std::vector<uint32_t> file_of;                 // per material: its file, or kInvalidIndex
+  std::vector<std::string> file_problem;         // per file
+  std::vector<std::optional<Texture>> decoded;   // per file
+};
+
+MaterialTextures read_material_textures(std::vector<std::string> texnames, const fs::path& base_dir,
+                                        const LoadLimits& limits, CancelFlag cancel) {
+  MaterialTextures t;
+  // 1. Which file each material names (sequential: directory listings are cached).
+  t.problem.resize(texnames.size());
+  t.file_of.assign(texnames.size(), kInvalidIndex);
+  std::vector<fs::path> files;
+  std::map<fs::path, uint32_t> file_index;
+  FileFinder finder;
+  for (size_t i = 0; i < texnames.size(); ++i) {
+    if (texnames[i].empty()) continue;
+    if (const std::optional<fs::path> file = finder.find(base_dir, texnames[i]); !file) {
+      t.problem[i] = "not found";
+    } else {
+      const auto [it, fresh] = file_index.try_emplace(*file, uint32_t(files.size()));
+      if (fresh) files.push_back(*file);
+      t.file_of[i] = it->second;
+    }
+  }
+  // 2. Every file read and its header checked, in parallel; 3. the total budget decided in file
+  // order (so which texture is left out never depends on threads); 4. the rest decoded in parallel.
+  std::vector<EncodedTexture> encoded(files.size());
+  t.file_problem.resize(files.size());
+  t.decoded.resize(files.size());
+  const auto guarded = [&](size_t k, auto&& work) {
+    try {
+      work();
+    } catch (const InputError& e) {
+      t.file_problem[k] = e.what();
+    }
+  };
+  limits.for_each(files.size(),
+                  [&](size_t k) { guarded(k, [&] { encoded[k] = read_texture(files[k], limits.textures, cancel); }); });
+  throw_if_cancelled(cancel);
+  uint64_t texture_bytes = 0;
+  for (size_t k = 0; k < files.size(); ++k) {
+    if (!t.file_problem[k].empty()) continue;
+    if (texture_bytes + encoded[k].decoded_bytes() > limits.textures.max_total_bytes) {
+      t.file_problem[k] = "the scene's textures would take more than " +
+                          std::to_string(limits.textures.max_total_bytes >> 20) + " MiB (--max-texture-mib raises it)";
+      encoded[k] = {};
+      continue;
+    }
+    texture_bytes += encoded[k].decoded_bytes();
+  }
+  limits.for_each(files.size(), [&](size_t k) {
+    if (t.file_problem[k].empty()) guarded(k, [&] { t.decoded[k] = decode_texture(encoded[k]); });
+    encoded[k] = {};  // the encoded bytes are no longer needed
+  });
+  throw_if_cancelled(cancel);
+  t.texnames = std::move(texnames);
+  return t;
+}
+
+std::vector<std::string> diffuse_texnames(const std::vector<tinyobj::material_t>& materials) {
+  std::vector<std::string> names;
+  names.reserve(materials.size());
+  for (const tinyobj::material_t& m : materials) names.push_back(m.diffuse_texname);
+  return names;
+}
+
 // Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
 // finite and within range, every face index inside the vertex array, material ids in range.
-Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path& base_dir, WarningLog& warnings,
-                  const LoadLimits& limits, CancelFlag cancel, LoadPhases& phases) {
+Scene build_scene(const Parsed& parsed, const std::string& name, MaterialTextures textures, WarningLog& warnings,
+                  CancelFlag cancel) {
   const tinyobj::attrib_t& attrib = parsed.attrib;
   Scene scene;
   scene.source = name;
@@ -329,64 +472,15 @@ Scene build_scene(const Parsed& parsed, const std::string& name, const fs::path&
     }
   }
 
-  const auto textures_start = Clock::now();
-  // map_Kd textures, each file read and decoded once; one warning for all that are missing or
-  // unreadable. The other maps (bump, Ks, Ka, alpha) are not used by any integrator, so not read.
-  // 1. Which file each material names (sequential: directory listings are cached).
-  std::vector<std::string> problem(parsed.materials.size());
-  std::vector<uint32_t> file_of(parsed.materials.size(), kInvalidIndex);
-  std::vector<fs::path> files;
-  std::map<fs::path, uint32_t> file_index;
-  FileFinder finder;
-  for (size_t i = 0; i < parsed.materials.size(); ++i) {
-    const std::string& texname = parsed.materials[i].diffuse_texname;
-    if (texname.empty()) continue;
-    if (const std::optional<fs::path> file = finder.find(base_dir, texname); !file) {
-      problem[i] = "not found";
-    } else {
-      const auto [it, fresh] = file_index.try_emplace(*file, uint32_t(files.size()));
-      if (fresh) files.push_back(*file);
-      file_of[i] = it->second;
-    }
-  }
-  // 2. Every file read and its header checked, in parallel; 3. the total budget decided in file
-  // order (so which texture is left out never depends on threads); 4. the rest decoded in parallel.
-  std::vector<EncodedTexture> encoded(files.size());
-  std::vector<std::string> file_problem(files.size());
-  std::vector<std::optional<Texture>> decoded(files.size());
-  const auto guarded = [&](size_t k, auto&& work) {
-    try {
-      work();
-    } catch (const InputError& e) {
-      file_problem[k] = e.what();
-    }
-  };
-  limits.for_each(files.size(),
-                  [&](size_t k) { guarded(k, [&] { encoded[k] = read_texture(files[k], limits.textures, cancel); }); });
-  throw_if_cancelled(cancel);
-  uint64_t texture_bytes = 0;
-  for (size_t k = 0; k < files.size(); ++k) {
-    if (!file_problem[k].empty()) continue;
-    if (texture_bytes + encoded[k].decoded_bytes() > limits.textures.max_total_bytes) {
-      file_problem[k] = "the scene's textures would take more than " +
-                        std::to_string(limits.textures.max_total_bytes >> 20) + " MiB (--max-texture-mib raises it)";
-      encoded[k] = {};
-      continue;
-    }
-    texture_bytes += encoded[k].decoded_bytes();
-  }
-  limits.for_each(files.size(), [&](size_t k) {
-    if (file_problem[k].empty()) guarded(k, [&] { decoded[k] = decode_texture(encoded[k]); });
-    encoded[k] = {};  // the encoded bytes are no longer needed
-  });
-  throw_if_cancelled(cancel);
-  std::vector<uint32_t> texture_of(files.size(), kInvalidIndex);
-  for (size_t k = 0; k < files.size(); ++k) {
-    if (!decoded[k]) continue;
+  std::vector<uint32_t> texture_of(textures.decoded.size(), kInvalidIndex);
+  for (size_t k = 0; k < textures.decoded.size(); ++k) {
+    if (!textures.decoded[k]) continue;
     texture_of[k] = uint32_t(scene.textures.size());
-    scene.textures.push_back(std::move(*decoded[k]));
+    scene.textures.push_back(std::move(*textures.decoded[k]));
   }
-  phases.textures_ms = ms_since(textures_start);
+  std::vector<std::string>& problem = textures.problem;
+  const std::vector<uint32_t>& file_of = textures.file_of;
+  const std::vector<std::string>& file_problem = textures.file_problem;
   size_t missing_textures = 0;
   std::string first_missing;
   for (size_t i = 0; i < parsed.materials.size(); ++i) {
@@ -501,12 +595,38 @@ Scene load(std::string& text, const std::string& name, const fs::path& base_dir,
   WarningLog warnings;
   LoadPhases local;
   LoadPhases& ph = phases ? *phases : local;
-  const auto parse_start = Clock::now();
-  const Parsed parsed = parse(text, name, mtl, warnings, cancel);
-  ph.parse_ms = ms_since(parse_start);
+  // The geometry parsed while the textures its MTL files name are read and decoded (when the
+  // caller's loop runs the two at once); a parse error wins over anything the textures hit.
+  std::vector<std::string> predicted = mtl.prefetch(mtllib_statements(text));
+  Parsed parsed;
+  std::optional<MaterialTextures> early;
+  std::exception_ptr failed[2];
+  limits.for_each(2, [&](size_t task) {
+    const auto task_start = Clock::now();
+    try {
+      if (task == 0) {
+        parsed = parse(text, name, mtl, warnings, cancel);
+        ph.parse_ms = ms_since(task_start);
+      } else if (!predicted.empty()) {
+        early = read_material_textures(std::move(predicted), base_dir, limits, cancel);
+        ph.textures_ms = ms_since(task_start);
+      }
+    } catch (...) {
+      failed[task] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : failed) {
+    if (e) std::rethrow_exception(e);
+  }
+  std::vector<std::string> texnames = diffuse_texnames(parsed.materials);
+  if (!early || early->texnames != texnames) {  // not foreseen: read them now
+    const auto textures_start = Clock::now();
+    early = read_material_textures(std::move(texnames), base_dir, limits, cancel);
+    ph.textures_ms = ms_since(textures_start);
+  }
   const auto build_start = Clock::now();
-  Scene scene = build_scene(parsed, name, base_dir, warnings, limits, cancel, ph);
-  ph.assembly_ms = ms_since(build_start) - ph.textures_ms;
+  Scene scene = build_scene(parsed, name, std::move(*early), warnings, cancel);
+  ph.assembly_ms = ms_since(build_start);
   warnings.flush(name, warn);
   return scene;
 }
