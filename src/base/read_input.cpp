@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <mutex>
@@ -83,7 +84,10 @@ std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_
   if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes) throw too_large();
   remember_input(st, name);
   std::string bytes;
-  if (S_ISREG(st.st_mode)) bytes.reserve(size_t(st.st_size));
+  // A regular file's size is known: one allocation, with a byte to spare for the read that sees
+  // its end (growing past it would copy the whole file once more into fresh pages, and first
+  // touches of pages are slow on a VM: 41 -> 22 ms for Sponza's 5.6 MB).
+  if (S_ISREG(st.st_mode)) bytes.reserve(size_t(st.st_size) + 1);
   constexpr size_t kChunk = 1 << 20;
   for (;;) {
     throw_if_cancelled(cancel);
@@ -94,8 +98,9 @@ std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_
     if (ready == 0 || (ready < 0 && errno == EINTR)) continue;
     if (bytes.size() > max_bytes) throw too_large();
     const size_t old = bytes.size();
-    bytes.resize(old + kChunk);
-    const ssize_t n = ::read(fd, bytes.data() + old, kChunk);
+    const size_t chunk = bytes.capacity() > old ? std::min(kChunk, bytes.capacity() - old) : kChunk;
+    bytes.resize(old + chunk);
+    const ssize_t n = ::read(fd, bytes.data() + old, chunk);
     if (n < 0) {
       if (errno == EINTR) {
         bytes.resize(old);
