@@ -388,11 +388,11 @@ Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, War
 // each file read and decoded once. The other maps (bump, Ks, Ka, alpha) are not used by any
 // integrator, so not read.
 struct MaterialTextures {
-  std::vector<std::string> texnames;             // what this was made for
-  std::vector<std::string> problem;              // per material: why its texture is not used
-  std::vector<uint32_t> file_of;                 // per material: its file, or kInvalidIndex
-  std::vector<std::string> file_problem;         // per file
-  std::vector<std::optional<Texture>> decoded;   // per file
+  std::vector<std::string> texnames;            // what this was made for
+  std::vector<std::string> problem;             // per material: why its texture is not used
+  std::vector<uint32_t> file_of;                // per material: its file, or kInvalidIndex
+  std::vector<std::string> file_problem;        // per file
+  std::vector<std::optional<Texture>> decoded;  // per file
 };
 
 MaterialTextures read_material_textures(std::vector<std::string> texnames, const fs::path& base_dir,
