@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "base/errors.hpp"
+#include "base/stopwatch.hpp"
 #include "cli/bench.hpp"
 #include "driver/progress.hpp"
 #include "driver/render_args.hpp"
@@ -25,10 +26,6 @@ namespace tracer::cli {
 using namespace driver;  // the flags, signals and statistics both binaries share
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 int cmd_render(const RenderArgs& args) {
   // Installed first, so a signal during loading or the build is not lost: both poll the flag.

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "base/errors.hpp"
+#include "base/stopwatch.hpp"
 #include "driver/progress.hpp"
 #include "driver/render_args.hpp"
 #include "driver/render_driver.hpp"
@@ -37,10 +38,6 @@
 
 namespace tracer::mpi {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // One line to stderr in one write, so lines from several ranks (and mpirun's own) never interleave.
 void say(const std::string& line) { std::fputs((line + "\n").c_str(), stderr); }

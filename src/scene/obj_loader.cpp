@@ -7,7 +7,6 @@
 
 #include <cerrno>
 #include <charconv>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +21,7 @@
 #include <unordered_map>
 
 #include "base/read_input.hpp"
+#include "base/stopwatch.hpp"
 #include "base/text.hpp"
 #include "scene/mtl_parser.hpp"
 #include "scene/texture.hpp"
@@ -40,11 +40,6 @@ constexpr size_t kCancelStride = 1 << 16;
 
 // Reads one number of an OBJ line. Accepts what tinyobjloader reads as a number (a leading '+',
 // values that underflow to zero) and rejects what it would silently turn into 0 or infinity.
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 float parse_coordinate(std::string_view tok, const std::string& name, size_t line) {
   std::string_view digits = tok;
   if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
@@ -186,7 +181,9 @@ class MtlSource : public tinyobj::MaterialReader {
     std::vector<std::string> texnames;
     for (const auto& names : statements) {
       for (const std::string& n : names) {
-        const MtlRead& r = cache_.try_emplace(n, read(n)).first->second;
+        auto it = cache_.find(n);
+        if (it == cache_.end()) it = cache_.emplace(n, read(n)).first;
+        const MtlRead& r = it->second;
         if (r.error) return texnames;  // the parse stops there
         if (!r.ok) continue;
         for (const tinyobj::material_t& t : r.materials) texnames.push_back(t.diffuse_texname);
