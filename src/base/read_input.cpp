@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -53,9 +54,7 @@ void remember_input(const struct stat& st, const std::string& name) {
 
 std::string mib(uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 
-}  // namespace
-
-std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
+InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_bytes, bool map) {
   const bool stdin_input = path == "-";
   const std::string name = stdin_input ? "<stdin>" : path;
   if (path.empty()) throw InputError("an empty file name was given");
@@ -83,6 +82,10 @@ std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_
   };
   if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes) throw too_large();
   remember_input(st, name);
+  if (map && S_ISREG(st.st_mode) && st.st_size > 0) {
+    void* mapping = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (mapping != MAP_FAILED) return InputBytes(static_cast<const char*>(mapping), size_t(st.st_size));
+  }
   std::string bytes;
   // A regular file's size is known: one allocation, with a byte to spare for the read that sees
   // its end (growing past it would copy the whole file once more into fresh pages, and first
@@ -112,7 +115,31 @@ std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_
     if (n == 0) break;
   }
   if (bytes.size() > max_bytes) throw too_large();
-  return bytes;
+  return InputBytes(std::move(bytes));
+}
+
+}  // namespace
+
+InputBytes::~InputBytes() {
+  if (mapping_) ::munmap(const_cast<char*>(mapping_), size_);
+}
+
+InputBytes& InputBytes::operator=(InputBytes&& o) noexcept {
+  if (this != &o) {
+    if (mapping_) ::munmap(const_cast<char*>(mapping_), size_);
+    bytes_ = std::move(o.bytes_);
+    mapping_ = std::exchange(o.mapping_, nullptr);
+    size_ = std::exchange(o.size_, 0);
+  }
+  return *this;
+}
+
+std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
+  return read_or_map(path, cancel, max_bytes, false).release();
+}
+
+InputBytes map_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
+  return read_or_map(path, cancel, max_bytes, true);
 }
 
 void check_not_an_input(const std::string& path, const std::string& flag) {
