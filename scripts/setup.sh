@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
   g++ clang cmake ninja-build pkg-config git ca-certificates
-  libtinyobjloader-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
+  libtinyobjloader-dev libfast-float-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
   libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
   libopenmpi-dev openmpi-bin

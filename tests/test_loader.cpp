@@ -13,6 +13,7 @@
 #include "base/errors.hpp"
 #include "scene/builtin.hpp"
 #include "scene/obj_loader.hpp"
+#include "scene/scene_checksum.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -69,6 +70,64 @@ TEST(Loader, PolygonsNegativeIndicesAndCrlf) {
   EXPECT_EQ(s.geometries.size(), 1u);
   EXPECT_EQ(s.geometries[0].name, "quad");
   EXPECT_EQ(s.triangles[0].v0, (Vec3{0, 0, 0}));
+}
+
+// The parser's chunks: a text split into chunks of a few bytes must give the very scene the whole
+// text gives as one chunk, whatever crosses the chunks (indices into earlier chunks, negative
+// indices, a chunk mixing both, materials and groups set before it).
+Scene load_in_chunks(const std::string& obj, const std::string& mtl, size_t chunk_bytes) {
+  LoadLimits limits;
+  limits.chunk_bytes = chunk_bytes;
+  return load_obj_from_string(
+      obj, mtl, "chunks.obj", [](const std::string&) {}, limits);
+}
+
+TEST(Loader, ChunksGiveTheSceneOneChunkGives) {
+  const std::string mtl = "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n";
+  std::string obj = "mtllib x.mtl\n";
+  for (int i = 0; i < 40; ++i) {
+    obj += "v " + std::to_string(i) + " " + std::to_string(i % 7) + " 0.5\nvt 0." + std::to_string(i) + " 1\n";
+    obj += "vn 0 0 1\n";
+    if (i % 9 == 0) obj += (i % 2 ? "usemtl red\n" : "usemtl blue\n");
+    if (i % 13 == 0) obj += "g part" + std::to_string(i) + "\n";
+    if (i >= 3) {
+      obj += "f -1/-1/-1 -2/-2/-2 -3/-3/-3\n";                                 // relative
+      obj += "f 1 " + std::to_string(i) + " " + std::to_string(i + 1) + "\n";  // absolute, into earlier chunks
+      obj += "f 1//1 2//2 " + std::to_string(i + 1) + "//3 -1//-1\n";          // both in one face: a quad
+    }
+  }
+  const Scene whole = load_in_chunks(obj, mtl, size_t(1) << 30);
+  ASSERT_EQ(whole.size(), 37u * 4u);
+  EXPECT_EQ(whole.geometries.size(), 4u);
+  for (const size_t bytes : {1u, 7u, 64u, 300u, 4096u}) {
+    SCOPED_TRACE(bytes);
+    const Scene chunked = load_in_chunks(obj, mtl, bytes);
+    EXPECT_EQ(scene_checksum(chunked), scene_checksum(whole));
+    EXPECT_EQ(chunked.tri_geom, whole.tri_geom);
+    EXPECT_EQ(chunked.tri_prim, whole.tri_prim);
+    EXPECT_EQ(chunked.tri_material, whole.tri_material);
+  }
+}
+
+TEST(Loader, AnErrorInALaterChunkNamesItsLine) {
+  std::string obj;
+  for (int i = 0; i < 500; ++i) obj += "v " + std::to_string(i) + " 0 0\n";
+  obj += "f 1 2 3\nf -1 -2 -501\n";  // reaches one vertex before the first
+  for (const size_t bytes : {size_t(16), size_t(1000), size_t(1) << 30}) {
+    SCOPED_TRACE(bytes);
+    try {
+      load_in_chunks(obj, "", bytes);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_STREQ(e.what(), "chunks.obj:502: vertex index -501 out of range (500 defined so far)");
+    }
+    try {
+      load_in_chunks(obj.substr(0, obj.size() - 13) + "f 1 2 x\n", "", bytes);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_STREQ(e.what(), "chunks.obj:502: malformed face index 'x'");
+    }
+  }
 }
 
 TEST(Loader, VertexNormalsAreKeptPerCorner) {

@@ -2,7 +2,6 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
-#include <tiny_obj_loader.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,6 +14,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <streambuf>
 #include <string_view>
@@ -24,6 +24,7 @@
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
 #include "scene/mtl_parser.hpp"
+#include "scene/obj_parser.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -31,162 +32,47 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// How often the long loops poll the cancel flag: often enough to stop within milliseconds.
-constexpr size_t kCancelStride = 1 << 16;
-
-[[noreturn]] void fail_at(const std::string& name, size_t line, const std::string& what) {
-  throw InputError(name + ":" + std::to_string(line) + ": " + what);
-}
-
-// Reads one number of an OBJ line. Accepts what tinyobjloader reads as a number (a leading '+',
-// values that underflow to zero) and rejects what it would silently turn into 0 or infinity.
-float parse_coordinate(std::string_view tok, const std::string& name, size_t line) {
-  std::string_view digits = tok;
-  if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
-  double value = 0;
-  const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-  if (ec == std::errc{} && ptr == digits.data() + digits.size()) {
-    if (!std::isfinite(value)) fail_at(name, line, "non-finite coordinate " + in_quotes(tok));
-    if (std::fabs(float(value)) > kMaxCoordinate) {
-      fail_at(name, line,
-              "number out of range " + in_quotes(tok) + " (coordinates must lie within +-" + kMaxCoordinateText + ")");
-    }
-    return float(value);
-  }
-  if (ec == std::errc::result_out_of_range && ptr == digits.data() + digits.size()) {
-    // Beyond double's range either way: strtod says which (0 for underflow, HUGE_VAL for overflow).
-    const double approx = std::strtod(std::string(digits).c_str(), nullptr);
-    if (std::fabs(approx) < 1.0) return 0.0f;
-    fail_at(name, line, "number out of range " + in_quotes(tok));
-  }
-  fail_at(name, line, "malformed number " + in_quotes(tok));
-}
-
-long long parse_index(std::string_view part, std::string_view tok, const std::string& name, size_t line) {
-  if (part.size() > 1 && part.front() == '+' && part[1] != '-' && part[1] != '+') part.remove_prefix(1);
-  long long index = 0;
-  const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), index);
-  if (part.empty() || ec != std::errc{} || ptr != part.data() + part.size()) {
-    fail_at(name, line, "malformed face index " + in_quotes(tok));
-  }
-  return index;
-}
-
-// tinyobjloader is lenient by design: it reads an unparsable number as 0 and keeps going on short
-// lines. This lint goes over the same lines (for_each_line splits them as tinyobjloader does) and
-// rejects all of that with the file and line. It is a diagnostic: what tinyobjloader produced is
-// checked again in build_scene, so nothing unchecked reaches the scene even where the two disagree.
-void lint_obj_text(std::string_view text, const std::string& name, CancelFlag cancel) {
-  size_t counts[3] = {0, 0, 0};  // v, vt, vn seen so far: OBJ indices refer backwards
-  for_each_line(text, [&](std::string_view line, size_t line_no) {
-    if (line_no % kCancelStride == 0) throw_if_cancelled(cancel);
-    line = trim(line);
-    if (line.empty() || line.front() == '#') return;
-    const std::string_view keyword = next_token(line);
-    if (keyword == "v" || keyword == "vt" || keyword == "vn") {
-      const size_t needed = keyword == "vt" ? 1 : 3;
-      size_t n = 0;
-      for (std::string_view tok = next_token(line); !tok.empty(); tok = next_token(line), ++n) {
-        parse_coordinate(tok, name, line_no);
-      }
-      if (n < needed) {
-        fail_at(
-            name, line_no,
-            "'" + std::string(keyword) + "' needs " + std::to_string(needed) + " numbers, got " + std::to_string(n));
-      }
-      ++counts[keyword == "v" ? 0 : (keyword == "vt" ? 1 : 2)];
-    } else if (keyword == "f") {
-      size_t corners = 0;
-      for (std::string_view tok = next_token(line); !tok.empty(); tok = next_token(line), ++corners) {
-        // v, v/vt, v//vn or v/vt/vn
-        std::string_view rest = tok;
-        for (int slot = 0; slot < 3 && !rest.empty(); ++slot) {
-          const size_t slash = rest.find('/');
-          const std::string_view part = rest.substr(0, slash);
-          rest.remove_prefix(slash == std::string_view::npos ? rest.size() : slash + 1);
-          if (part.empty() && slot == 1) continue;  // v//vn
-          const long long index = parse_index(part, tok, name, line_no);
-          const auto count = static_cast<long long>(counts[slot]);
-          if (index == 0 || index > count || index < -count) {
-            static const char* kinds[3] = {"vertex", "texture coordinate", "normal"};
-            fail_at(name, line_no,
-                    std::string(kinds[slot]) + " index " + std::to_string(index) + " out of range (" +
-                        std::to_string(count) + " defined so far)");
-          }
-        }
-      }
-      if (corners < 3) fail_at(name, line_no, "face needs at least 3 vertices, got " + std::to_string(corners));
-    }
-  });
-}
-
-// tinyobjloader reads its input through a stream; this one serves the bytes already in memory and
-// polls the cancel flag between chunks, so a Ctrl-C stops the parse of a large file at once.
-class CancellableBuffer : public std::streambuf {
- public:
-  CancellableBuffer(std::string_view bytes, CancelFlag cancel) : bytes_(bytes), cancel_(cancel) {}
-
- protected:
-  int_type underflow() override {
-    throw_if_cancelled(cancel_);
-    if (served_ >= bytes_.size()) return traits_type::eof();
-    char* begin = const_cast<char*>(bytes_.data()) + served_;  // read-only use: get area only
-    const size_t n = std::min<size_t>(bytes_.size() - served_, 1 << 20);
-    setg(begin, begin, begin + n);
-    served_ += n;
-    return traits_type::to_int_type(*begin);
-  }
-
- private:
-  std::string_view bytes_;
-  CancelFlag cancel_;
-  size_t served_ = 0;
-};
-
 // Resolves `mtllib` names: from files beside the OBJ (each read once, like the OBJ), or from one
-// text in memory (tests, fuzzing). Our own strict parser reads them (scene/mtl_parser.hpp):
-// tinyobjloader's reads `Kd 0.5` as red and a malformed number as 0.
-class MtlSource : public tinyobj::MaterialReader {
+// text in memory (tests, fuzzing), by the strict MTL parser (scene/mtl_parser.hpp).
+class MtlSource {
  public:
   static MtlSource from_directory(fs::path dir, CancelFlag cancel) {
     return MtlSource(std::move(dir), {}, false, cancel);
   }
   static MtlSource from_text(std::string text) { return MtlSource({}, std::move(text), true, nullptr); }
 
-  // tinyobjloader's callback for each `mtllib` name: what read() gives, from the cache when
-  // prefetch() has read that name already. A malformed MTL (or one that never ends) throws here,
-  // when the parse reaches its `mtllib` line, as if it had been read just now.
-  bool operator()(const std::string& mtl_name, std::vector<tinyobj::material_t>* materials,
-                  std::map<std::string, int>* material_map, std::string* warn, std::string*) override {
-    const auto cached = cache_.find(mtl_name);
-    const MtlRead r = cached != cache_.end() ? cached->second : read(mtl_name);
-    if (r.error) std::rethrow_exception(r.error);
-    if (!r.ok) {
-      if (warn) *warn += r.warn;
-      return false;
-    }
-    for (const tinyobj::material_t& t : r.materials) {
-      material_map->insert({t.name, int(materials->size())});  // the first of a name wins
-      materials->push_back(t);
-    }
-    return true;
+  // One `mtllib` name read: its materials, or why not (a warning when it cannot be opened, an
+  // error to throw when it is malformed, too large, or the read was cancelled).
+  struct MtlRead {
+    bool ok = false;
+    std::string warn;
+    std::vector<MtlMaterial> materials;
+    std::exception_ptr error;
+  };
+
+  // What `name` reads as, read once.
+  const MtlRead& get(const std::string& name) {
+    auto it = cache_.find(name);
+    if (it == cache_.end()) it = cache_.emplace(name, read(name)).first;
+    return it->second;
   }
 
   // Reads the MTL files of the OBJ's `mtllib` statements (each a list of names, of which the first
-  // that reads is used, as tinyobjloader does) before the parse, and returns the diffuse texture
-  // names of the materials they will give, in order: the textures can then be read while the
-  // geometry is parsed. A name split differently from tinyobjloader's is read again by it, and the
-  // prediction is checked against what the parse gives (load()), so it only ever saves time.
+  // that reads is used) before the OBJ is parsed, and returns the diffuse texture names of the
+  // materials they will give, in order: the textures can then be read while the geometry is
+  // parsed. The prediction is checked against what the parse gives (load()), so it only ever
+  // saves time.
   std::vector<std::string> prefetch(const std::vector<std::vector<std::string>>& statements) {
     std::vector<std::string> texnames;
+    std::set<std::string> loaded;
     for (const auto& names : statements) {
       for (const std::string& n : names) {
-        auto it = cache_.find(n);
-        if (it == cache_.end()) it = cache_.emplace(n, read(n)).first;
-        const MtlRead& r = it->second;
-        if (r.error) return texnames;  // the parse stops there
+        if (loaded.count(n)) break;
+        const MtlRead& r = get(n);
+        if (r.error) return texnames;  // the load stops there
         if (!r.ok) continue;
-        for (const tinyobj::material_t& t : r.materials) texnames.push_back(t.diffuse_texname);
+        loaded.insert(n);
+        for (const MtlMaterial& m : r.materials) texnames.push_back(m.diffuse_map);
         break;
       }
     }
@@ -196,15 +82,6 @@ class MtlSource : public tinyobj::MaterialReader {
  private:
   // An MTL file is text of a few kilobytes; past this it is not one (/dev/zero, a runaway pipe).
   static constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;
-
-  // One `mtllib` name read: its materials, or why not (a warning when it cannot be opened, an
-  // error to throw when it is malformed, too large, or the read was cancelled).
-  struct MtlRead {
-    bool ok = false;
-    std::string warn;
-    std::vector<tinyobj::material_t> materials;
-    std::exception_ptr error;
-  };
 
   MtlRead read(const std::string& mtl_name) const {
     MtlRead r;
@@ -221,29 +98,12 @@ class MtlSource : public tinyobj::MaterialReader {
         } catch (const InputTooLarge&) {
           throw;  // a file that never ends is an error, not a missing material library
         } catch (const InputError& e) {
-          r.warn = std::string(e.what()) + "\n";
+          r.warn = e.what();
           return r;
         }
       }
       strip_bom(text);
-      for (const MtlMaterial& m : parse_mtl(text, name, cancel_)) {
-        tinyobj::material_t t{};  // zeroed: its texture options have no initialisers
-        t.name = m.name;
-        for (int i = 0; i < 3; ++i) {
-          t.ambient[i] = m.ka[i];
-          t.diffuse[i] = m.kd[i];
-          t.specular[i] = m.ks[i];
-          t.emission[i] = m.ke[i];
-          t.transmittance[i] = m.tf[i];
-        }
-        t.shininess = m.ns;
-        t.ior = m.ni;
-        t.dissolve = m.dissolve;
-        t.illum = m.illum;
-        t.diffuse_texname = m.diffuse_map;
-        t.bump_texname = m.bump_map;
-        r.materials.push_back(std::move(t));
-      }
+      r.materials = parse_mtl(text, name, cancel_);
       r.ok = true;
     } catch (...) {
       r.error = std::current_exception();
@@ -332,53 +192,21 @@ class WarningLog {
   std::unordered_map<std::string, size_t> index_;
 };
 
-Material to_material(const tinyobj::material_t& m, const std::string& name) {
+Material to_material(const MtlMaterial& m, const std::string& name) {
   Material mat;
   mat.name = m.name;
-  mat.kd = {float(m.diffuse[0]), float(m.diffuse[1]), float(m.diffuse[2])};
-  mat.ks = {float(m.specular[0]), float(m.specular[1]), float(m.specular[2])};
-  mat.ke = {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])};
-  mat.tf = {float(m.transmittance[0]), float(m.transmittance[1]), float(m.transmittance[2])};
-  mat.ni = float(m.ior);
-  mat.ns = float(m.shininess);
+  mat.kd = m.kd;
+  mat.ks = m.ks;
+  mat.ke = m.ke;
+  mat.tf = m.tf;
+  mat.ni = m.ni;
+  mat.ns = m.ns;
   mat.illum = m.illum;
   if (!is_finite(mat.kd) || !is_finite(mat.ks) || !is_finite(mat.ke) || !is_finite(mat.tf) || !std::isfinite(mat.ni) ||
       !std::isfinite(mat.ns)) {
     throw InputError(name + ": material " + in_quotes(m.name) + " has a non-finite colour or index");
   }
   return mat;
-}
-
-struct Parsed {
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
-  std::vector<tinyobj::material_t> materials;
-};
-
-// tinyobjloader's errors say "line N" somewhere in their text; ours start with file:N.
-std::string parser_error(const std::string& name, const std::string& err) {
-  const std::string first = std::string(trim(std::string_view(err).substr(0, err.find('\n'))));
-  const size_t at = first.find("line ");
-  if (at != std::string::npos) {
-    size_t line = 0;
-    const char* b = first.data() + at + 5;
-    const auto [ptr, ec] = std::from_chars(b, first.data() + first.size(), line);
-    if (ec == std::errc{} && ptr != b) return name + ":" + std::to_string(line) + ": " + escaped(first);
-  }
-  return name + ": " + (first.empty() ? std::string("parse error") : escaped(first));
-}
-
-Parsed parse(std::string_view text, const std::string& name, MtlSource& mtl, WarningLog& warnings, CancelFlag cancel) {
-  lint_obj_text(text, name, cancel);
-  Parsed p;
-  CancellableBuffer buffer(text, cancel);
-  std::istream in(&buffer);
-  std::string warn, err;
-  const bool ok = tinyobj::LoadObj(&p.attrib, &p.shapes, &p.materials, &warn, &err, &in, &mtl, /*triangulate=*/true,
-                                   /*default_vcols_fallback=*/false);
-  warnings.add_lines(warn);
-  if (!ok || !err.empty()) throw InputError(parser_error(name, err));
-  return p;
 }
 
 // The map_Kd textures of a list of materials (their diffuse texture names, in material order),
@@ -446,29 +274,97 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
   return t;
 }
 
-std::vector<std::string> diffuse_texnames(const std::vector<tinyobj::material_t>& materials) {
+std::vector<std::string> diffuse_texnames(const std::vector<MtlMaterial>& materials) {
   std::vector<std::string> names;
   names.reserve(materials.size());
-  for (const tinyobj::material_t& m : materials) names.push_back(m.diffuse_texname);
+  for (const MtlMaterial& m : materials) names.push_back(m.diffuse_map);
   return names;
 }
 
-// Turns what tinyobjloader produced into a Scene, checking every value that is kept: vertices
-// finite and within range, every face index inside the vertex array, material ids in range.
-Scene build_scene(const Parsed& parsed, const std::string& name, MaterialTextures textures, WarningLog& warnings,
-                  CancelFlag cancel) {
-  const tinyobj::attrib_t& attrib = parsed.attrib;
-  Scene scene;
-  scene.source = name;
-  scene.vertex_count = attrib.vertices.size() / 3;
-  for (size_t i = 0; i < attrib.vertices.size(); ++i) {
-    const float c = attrib.vertices[i];
-    if (!std::isfinite(c) || std::fabs(c) > kMaxCoordinate) {
-      throw InputError(name + ": vertex " + std::to_string(i / 3 + 1) + " has a coordinate out of range (" +
-                       std::to_string(c) + ")");
+// What the statements of an OBJ make of its triangles: the materials its `mtllib` files define (in
+// the order they are read), and which material and geometry each run of triangles takes. A
+// `usemtl` names a material of the files read before it; `g` and `o` start a geometry.
+struct Layout {
+  std::vector<MtlMaterial> materials;
+  std::vector<TriangleRun> runs;
+  std::vector<Geometry> geometries;
+  bool uses_default = false;  // some triangles have no material: the default one is appended
+};
+
+Layout lay_out(const ObjGeometry& obj, MtlSource& mtl, WarningLog& warnings) {
+  Layout out;
+  std::unordered_map<std::string, uint32_t> by_name;
+  std::set<std::string> loaded;
+  uint32_t material = kInvalidIndex;
+  std::string group;
+  bool open = false;  // whether geometries.back() takes the triangles at `at`
+  uint64_t at = 0;
+  const auto take_until = [&](uint64_t end) {
+    if (end <= at) return;
+    if (!open) {
+      out.geometries.push_back({group, static_cast<uint32_t>(at), 0});
+      open = true;
+    }
+    const auto geometry = static_cast<uint32_t>(out.geometries.size() - 1);
+    if (out.runs.empty() || out.runs.back().material != material || out.runs.back().geometry != geometry) {
+      out.runs.push_back({at, material, geometry});
+    }
+    at = end;
+  };
+  const auto close = [&] {
+    if (open) out.geometries.back().triangle_count = static_cast<uint32_t>(at - out.geometries.back().first_triangle);
+    open = false;
+  };
+  for (const ObjStatement& s : obj.statements()) {
+    take_until(s.triangle);
+    switch (s.kind) {
+      case ObjStatement::Kind::UseMtl: {
+        const auto it = by_name.find(s.names[0]);
+        material = it == by_name.end() ? kInvalidIndex : it->second;
+        if (it == by_name.end()) warnings.add("material [ '" + s.names[0] + "' ] not found in .mtl");
+        break;
+      }
+      case ObjStatement::Kind::Group:
+        close();
+        group = s.names[0];
+        break;
+      case ObjStatement::Kind::MtlLib: {
+        if (s.names.empty()) warnings.add("'mtllib' without a file name (line " + std::to_string(s.line) + ")");
+        bool found = false;
+        for (const std::string& n : s.names) {
+          if (loaded.count(n)) {
+            found = true;
+            break;
+          }
+          const MtlSource::MtlRead& r = mtl.get(n);
+          if (r.error) std::rethrow_exception(r.error);
+          if (!r.warn.empty()) warnings.add(r.warn);
+          if (!r.ok) continue;
+          loaded.insert(n);
+          for (const MtlMaterial& m : r.materials) {
+            by_name.try_emplace(m.name, static_cast<uint32_t>(out.materials.size()));  // the first of a name wins
+            out.materials.push_back(m);
+          }
+          found = true;
+          break;
+        }
+        if (!s.names.empty() && !found) warnings.add("Failed to load material file(s). Use default material.");
+        break;
+      }
     }
   }
+  take_until(obj.triangle_count());
+  close();
+  const auto default_material = static_cast<uint32_t>(out.materials.size());
+  for (TriangleRun& r : out.runs) {
+    if (r.material == kInvalidIndex) r.material = default_material, out.uses_default = true;
+  }
+  return out;
+}
 
+// The scene's materials, their textures attached (with one grouped warning for those not used).
+void add_materials(Scene& scene, const Layout& layout, MaterialTextures textures, const std::string& name,
+                   WarningLog& warnings) {
   std::vector<uint32_t> texture_of(textures.decoded.size(), kInvalidIndex);
   for (size_t k = 0; k < textures.decoded.size(); ++k) {
     if (!textures.decoded[k]) continue;
@@ -476,133 +372,48 @@ Scene build_scene(const Parsed& parsed, const std::string& name, MaterialTexture
     scene.textures.push_back(std::move(*textures.decoded[k]));
   }
   std::vector<std::string>& problem = textures.problem;
-  const std::vector<uint32_t>& file_of = textures.file_of;
-  const std::vector<std::string>& file_problem = textures.file_problem;
   size_t missing_textures = 0;
   std::string first_missing;
-  for (size_t i = 0; i < parsed.materials.size(); ++i) {
-    const tinyobj::material_t& m = parsed.materials[i];
+  for (size_t i = 0; i < layout.materials.size(); ++i) {
+    const MtlMaterial& m = layout.materials[i];
     Material mat = to_material(m, name);
-    if (file_of[i] != kInvalidIndex) {
-      mat.diffuse_texture = texture_of[file_of[i]];
-      if (mat.diffuse_texture == kInvalidIndex) problem[i] = file_problem[file_of[i]];
+    if (const uint32_t file = textures.file_of[i]; file != kInvalidIndex) {
+      mat.diffuse_texture = texture_of[file];
+      if (mat.diffuse_texture == kInvalidIndex) problem[i] = textures.file_problem[file];
     }
-    if (!problem[i].empty() && missing_textures++ == 0)
-      first_missing = in_quotes(m.diffuse_texname) + ": " + problem[i];
+    if (!problem[i].empty() && missing_textures++ == 0) first_missing = in_quotes(m.diffuse_map) + ": " + problem[i];
     scene.materials.push_back(std::move(mat));
   }
   if (missing_textures > 0) {
     warnings.add(std::to_string(missing_textures) + " map_Kd texture(s) not used (first " + first_missing +
                  "); those materials use Kd");
   }
-  const auto default_material = static_cast<uint32_t>(scene.materials.size());
-  bool used_default = false;
-
-  size_t faces_seen = 0;
-  const size_t normal_count = attrib.normals.size() / 3;
-  const size_t uv_count = attrib.texcoords.size() / 2;
-  bool any_normal = false, any_uv = false;
-  std::vector<Vec3> corner_normals;
-  std::vector<Vec2> corner_uvs;
-  // Sized once: growing six arrays by doubling cost a third of this function on large scenes.
-  size_t triangle_faces = 0;
-  for (const tinyobj::shape_t& shape : parsed.shapes) {
-    for (const unsigned int fv : shape.mesh.num_face_vertices) triangle_faces += fv == 3 ? 1 : 0;
-  }
-  corner_normals.reserve(3 * triangle_faces);
-  corner_uvs.reserve(3 * triangle_faces);
-  scene.triangles.reserve(triangle_faces);
-  scene.tri_prim.reserve(triangle_faces);
-  scene.tri_geom.reserve(triangle_faces);
-  scene.tri_material.reserve(triangle_faces);
-  for (const tinyobj::shape_t& shape : parsed.shapes) {
-    const tinyobj::mesh_t& mesh = shape.mesh;
-    Geometry g;
-    g.name = shape.name;
-    g.first_triangle = static_cast<uint32_t>(scene.triangles.size());
-    const auto geom_id = static_cast<uint32_t>(scene.geometries.size());
-    size_t offset = 0;
-    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-      if (++faces_seen % kCancelStride == 0) throw_if_cancelled(cancel);
-      const size_t fv = mesh.num_face_vertices[f];
-      if (offset + fv > mesh.indices.size())
-        throw InputError(name + ": face " + std::to_string(faces_seen) + " is incomplete");
-      if (fv == 3) {
-        Vec3 p[3];
-        for (size_t k = 0; k < 3; ++k) {
-          const auto vi = static_cast<size_t>(mesh.indices[offset + k].vertex_index);
-          if (vi >= scene.vertex_count)
-            throw InputError(name + ": face " + std::to_string(faces_seen) + " has a vertex index out of range");
-          p[k] = {attrib.vertices[3 * vi], attrib.vertices[3 * vi + 1], attrib.vertices[3 * vi + 2]};
-          const int ni = mesh.indices[offset + k].normal_index;
-          Vec3 normal{0.0f};
-          if (ni >= 0) {
-            if (size_t(ni) >= normal_count)
-              throw InputError(name + ": face " + std::to_string(faces_seen) + " has a normal index out of range");
-            normal = {attrib.normals[3 * size_t(ni)], attrib.normals[3 * size_t(ni) + 1],
-                      attrib.normals[3 * size_t(ni) + 2]};
-            if (!is_finite(normal)) throw InputError(name + ": normal " + std::to_string(ni + 1) + " is not finite");
-            any_normal = true;
-          }
-          corner_normals.push_back(normal);
-          const int ti = mesh.indices[offset + k].texcoord_index;
-          Vec2 uv;
-          if (ti >= 0) {
-            if (size_t(ti) >= uv_count)
-              throw InputError(name + ": face " + std::to_string(faces_seen) +
-                               " has a texture coordinate index out of range");
-            uv = {attrib.texcoords[2 * size_t(ti)], attrib.texcoords[2 * size_t(ti) + 1]};
-            if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
-              throw InputError(name + ": texture coordinate " + std::to_string(ti + 1) + " is not finite");
-            any_uv = true;
-          }
-          corner_uvs.push_back(uv);
-        }
-        const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
-        uint32_t material = default_material;
-        if (mid >= 0 && static_cast<size_t>(mid) < scene.materials.size()) {
-          material = static_cast<uint32_t>(mid);
-        } else {
-          used_default = true;
-        }
-        scene.tri_prim.push_back(static_cast<uint32_t>(scene.triangles.size() - g.first_triangle));
-        scene.triangles.push_back({p[0], p[1], p[2]});
-        scene.tri_geom.push_back(geom_id);
-        scene.tri_material.push_back(material);
-      }
-      offset += fv;
-    }
-    g.triangle_count = static_cast<uint32_t>(scene.triangles.size() - g.first_triangle);
-    if (g.triangle_count > 0) scene.geometries.push_back(std::move(g));
-  }
-  if (used_default) scene.materials.push_back(Material{});
-  if (scene.triangles.empty()) throw InputError(name + ": scene has no triangles");
-  if (any_normal) scene.corner_normals = std::move(corner_normals);
-  if (any_uv) scene.corner_uvs = std::move(corner_uvs);
-  scene.finalize();
-  return scene;
+  if (layout.uses_default) scene.materials.push_back(Material{});
 }
 
 void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
-Scene load(std::string& text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
+Scene load(std::string_view text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
            const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits, LoadPhases* phases) {
   const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
-  strip_bom(text);
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // a UTF-8 byte-order mark
   WarningLog warnings;
   LoadPhases local;
   LoadPhases& ph = phases ? *phases : local;
   // The geometry parsed while the textures its MTL files name are read and decoded (when the
   // caller's loop runs the two at once); a parse error wins over anything the textures hit.
   std::vector<std::string> predicted = mtl.prefetch(mtllib_statements(text));
-  Parsed parsed;
+  if (!limits.read_textures) predicted.clear();
+  ObjGeometry obj;
+  Layout layout;
   std::optional<MaterialTextures> early;
   std::exception_ptr failed[2];
   limits.for_each(2, [&](size_t task) {
     const auto task_start = Clock::now();
     try {
       if (task == 0) {
-        parsed = parse(text, name, mtl, warnings, cancel);
+        obj = ObjGeometry::parse(text, name, limits.for_each, cancel, limits.chunk_bytes);
+        layout = lay_out(obj, mtl, warnings);
         ph.parse_ms = ms_since(task_start);
       } else if (!predicted.empty()) {
         early = read_material_textures(std::move(predicted), base_dir, limits, cancel);
@@ -615,14 +426,23 @@ Scene load(std::string& text, const std::string& name, const fs::path& base_dir,
   for (const std::exception_ptr& e : failed) {
     if (e) std::rethrow_exception(e);
   }
-  std::vector<std::string> texnames = diffuse_texnames(parsed.materials);
+  if (obj.triangle_count() == 0) throw InputError(name + ": scene has no triangles");
+  std::vector<std::string> texnames = diffuse_texnames(layout.materials);
+  if (!limits.read_textures) texnames.assign(texnames.size(), std::string());
   if (!early || early->texnames != texnames) {  // not foreseen: read them now
     const auto textures_start = Clock::now();
     early = read_material_textures(std::move(texnames), base_dir, limits, cancel);
     ph.textures_ms = ms_since(textures_start);
   }
   const auto build_start = Clock::now();
-  Scene scene = build_scene(parsed, name, std::move(*early), warnings, cancel);
+  Scene scene;
+  scene.source = name;
+  add_materials(scene, layout, std::move(*early), name, warnings);
+  std::vector<uint32_t> geometry_first;
+  for (const Geometry& g : layout.geometries) geometry_first.push_back(g.first_triangle);
+  obj.assemble(scene, layout.runs, geometry_first, limits.for_each, cancel);
+  scene.geometries = std::move(layout.geometries);
+  scene.finalize();
   ph.assembly_ms = ms_since(build_start);
   warnings.flush(name, warn);
   return scene;
@@ -633,18 +453,17 @@ Scene load(std::string& text, const std::string& name, const fs::path& base_dir,
 Scene load_obj(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits,
                LoadPhases* phases) {
   const auto read_start = Clock::now();
-  std::string text = read_input(path, cancel, limits.max_obj_bytes);
+  const InputBytes bytes = map_input(path, cancel, limits.max_obj_bytes);
   if (phases) phases->read_ms = ms_since(read_start);
   const fs::path base_dir = path == "-" ? fs::path() : fs::path(path).parent_path();
-  return load(text, path == "-" ? std::string("<stdin>") : path, base_dir,
+  return load(bytes.view(), path == "-" ? std::string("<stdin>") : path, base_dir,
               MtlSource::from_directory(base_dir.empty() ? fs::path(".") : base_dir, cancel), warn, cancel, limits,
               phases);
 }
 
 Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
-                           const WarningSink& warn) {
-  std::string text = obj_text;
-  return load(text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr, LoadLimits{}, nullptr);
+                           const WarningSink& warn, const LoadLimits& limits) {
+  return load(obj_text, name, fs::path("."), MtlSource::from_text(mtl_text), warn, nullptr, limits, nullptr);
 }
 
 }  // namespace tracer

@@ -1,7 +1,6 @@
-// OBJ/MTL loading: the bytes are read once, tinyobjloader parses them, and what it produced is
-// checked before it becomes a Scene. A line-aware lint over the same lines (split exactly as
-// tinyobjloader splits them) names the file and line of malformed text that tinyobjloader would
-// silently read as 0.
+// OBJ/MTL loading: the bytes are read once and parsed in parallel chunks (scene/obj_parser.hpp),
+// the MTL files by the strict MTL parser, the textures read and decoded while the geometry is
+// parsed; every error names the file and line.
 #pragma once
 
 #include <functional>
@@ -9,6 +8,7 @@
 
 #include "base/errors.hpp"
 #include "base/read_input.hpp"
+#include "scene/obj_parser.hpp"
 #include "scene/scene.hpp"
 #include "scene/texture.hpp"
 
@@ -22,19 +22,14 @@ using WarningSink = std::function<void(const std::string&)>;
 // including a pipe; "-" reads standard input (MTL files then resolve from the current directory).
 // Throws InputError with a one-line message naming the file and, where there is one, the line;
 // Cancelled when `cancel` is set during loading.
-// body(i) for every i in [0, count), possibly in parallel: how textures are read and decoded.
-// The loader knows nothing of threads; the caller hands it an executor's loop.
-using ForEach = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
-inline void sequential_for_each(size_t count, const std::function<void(size_t)>& body) {
-  for (size_t i = 0; i < count; ++i) body(i);
-}
-
 // What a load may read (the OBJ's size, MTL files 64 MiB each, the textures' texels), and the
 // loop it reads and decodes textures with.
 struct LoadLimits {
   uint64_t max_obj_bytes = kDefaultMaxInputBytes;
   TextureLimits textures;
   ForEach for_each = sequential_for_each;
+  size_t chunk_bytes = 0;     // the OBJ parser's chunk size; 0: from the file's size
+  bool read_textures = true;  // false: no map_Kd file is read, materials use Kd (geometry-only loads)
 };
 
 // Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its
@@ -49,6 +44,6 @@ Scene load_obj(const std::string& path, const WarningSink& warn = {}, CancelFlag
 // The same from memory (fuzzing, tests); `name` stands for the file in messages, and `mtl_text`
 // serves every `mtllib` the OBJ names.
 Scene load_obj_from_string(const std::string& obj_text, const std::string& mtl_text, const std::string& name,
-                           const WarningSink& warn = {});
+                           const WarningSink& warn = {}, const LoadLimits& limits = {});
 
 }  // namespace tracer
