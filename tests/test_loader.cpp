@@ -186,7 +186,7 @@ TEST(Loader, BadInputsGiveOneLineErrorsWithLine) {
       {"huge_number", "v 0 0 1e999\n", "bad.obj:1: number out of range '1e999'"},
       {"beyond_supported_range", "v 0 0 1.0001e12\n",
        "bad.obj:1: number out of range '1.0001e12' (coordinates must lie within +-1e12)"},
-      // tinyobjloader ends a line at a lone CR: the vertex after it is a line of its own, checked.
+      // A lone CR ends a line: the vertex after it is a line of its own, checked.
       {"cr_inside_comment", "# c\rv 1e39 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n",
        "bad.obj:2: number out of range '1e39'"},
       {"cr_only_lines", "v 0 0 0\rv 1 0 0\rf 1 2 3\r", "bad.obj:3: vertex index 3 out of range (2 defined so far)"},

@@ -52,8 +52,8 @@ inline std::string in_quotes(std::string_view tok) {
   return "'" + escaped(tok.substr(0, 40)) + (tok.size() > 40 ? "...'" : "'");
 }
 
-// Calls fn(line, number) for every line, numbered from 1, split the way tinyobjloader splits its
-// input (at "\n", "\r\n" and a lone "\r"), so both readers see the same lines with the same numbers.
+// Calls fn(line, number) for every line, numbered from 1, split at "\n", "\r\n" and a lone "\r"
+// (as the OBJ parser splits them, and as old Mac exporters end lines).
 template <class Fn>
 void for_each_line(std::string_view text, Fn&& fn) {
   size_t line_no = 0;

@@ -1,22 +1,12 @@
 #include "scene/obj_loader.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <iostream>
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
-#include <streambuf>
 #include <string_view>
 #include <unordered_map>
 
@@ -120,8 +110,9 @@ class MtlSource {
   std::map<std::string, MtlRead> cache_;
 };
 
-// The names of each `mtllib` statement, in file order, split at blanks (tinyobjloader also honours
-// backslash escapes; such a name is then simply not prefetched).
+// The names of each `mtllib` statement, in file order, split at blanks as the parser splits them:
+// found by a search for the word before the parse, so the MTL files and their textures can be
+// read while the OBJ is parsed.
 std::vector<std::vector<std::string>> mtllib_statements(std::string_view text) {
   std::vector<std::vector<std::string>> statements;
   for (size_t at = text.find("mtllib"); at != std::string_view::npos; at = text.find("mtllib", at + 6)) {
