@@ -21,7 +21,7 @@ field() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 # measure NAME VIEWS OBJ: one row of scale.tsv.
 measure() {
   local name=$1 views=$2 obj=$3 load tiny a
-  load=$($L "$obj" --runs 3)
+  load=$($L "$obj" --runs 3 --threads 2)
   tiny=$(sed 's/.*"tinyobjloader_ms": \([0-9.]*\).*/\1/' <<<"$load")
   load=$(sed 's/.*"tracer_ms": \([0-9.]*\).*/\1/' <<<"$load")
   local row="$name"
