@@ -170,11 +170,18 @@ void ObjGeometry::Chunk::parse(const std::string& name, const uint64_t* prefix, 
   const char* p = text.data();
   const char* const end = p + text.size();
   uint64_t local = 0;
-  // Lines end at "\n", "\r\n" or a lone "\r" (as for_each_line splits them).
+  // Lines end at "\n", "\r\n" or a lone "\r" (as for_each_line splits them). The next '\n' is
+  // searched for once and kept, so a file of lone-'\r' lines is not searched to its end per line.
+  const char* nl = p;
+  bool nl_known = false;
   while (p < end) {
-    const char* eol = static_cast<const char*>(std::memchr(p, '\n', size_t(end - p)));
-    if (!eol) eol = end;
-    if (const void* cr = std::memchr(p, '\r', size_t(eol - p))) eol = static_cast<const char*>(cr);
+    if (!nl_known || nl < p) {
+      nl = static_cast<const char*>(std::memchr(p, '\n', size_t(end - p)));
+      if (!nl) nl = end;
+      nl_known = true;
+    }
+    const char* eol = nl;
+    if (const void* cr = std::memchr(p, '\r', size_t(nl - p))) eol = static_cast<const char*>(cr);
     ++local;
     if (local % kCancelStride == 0) throw_if_cancelled(cancel);
     const uint64_t line = first_line + local - 1;
