@@ -54,19 +54,27 @@ float parse_coordinate(std::string_view tok, const std::string& name, uint64_t l
   fail_at(name, line, "non-finite coordinate " + in_quotes(tok));
 }
 
+// One index of a corner written plainly: an optional '-' and at most 18 digits.
+bool parse_plain_index(const char*& p, const char* end, long long& out) {
+  const char* q = p;
+  const bool negative = q != end && *q == '-';
+  q += negative ? 1 : 0;
+  uint64_t v = 0;  // unsigned: a longer run of digits wraps (and is refused below), never overflows
+  const char* digits = q;
+  for (; q != end && static_cast<unsigned>(*q - '0') < 10; ++q) v = v * 10 + uint64_t(*q - '0');
+  if (q == digits || q - digits > 18) return false;
+  out = negative ? -static_cast<long long>(v) : static_cast<long long>(v);
+  p = q;
+  return true;
+}
+
 // One index of a face corner: an optional sign and decimal digits (a '+' is accepted).
 long long parse_index(std::string_view part, std::string_view tok, const std::string& name, uint64_t line) {
   const char* p = part.data();
   const char* const e = p + part.size();
   if (e - p > 1 && *p == '+' && p[1] != '-' && p[1] != '+') ++p;
-  const char* q = p + (p != e && *p == '-' ? 1 : 0);
-  if (q != e && e - q <= 18) {  // the common case: at most 18 digits cannot overflow
-    long long v = 0;
-    const char* d = q;
-    for (; d != e && static_cast<unsigned>(*d - '0') < 10; ++d) v = v * 10 + (*d - '0');
-    if (d == e) return q == p ? v : -v;
-  }
   long long index = 0;
+  if (const char* q = p; parse_plain_index(q, e, index) && q == e) return index;
   const auto [ptr, ec] = std::from_chars(p, e, index);
   if (p == e || ec != std::errc{} || ptr != e) fail_at(name, line, "malformed face index " + in_quotes(tok));
   return index;
@@ -97,20 +105,6 @@ bool parse_plain_decimal(const char*& p, const char* end, float& out) {
   const float f = float(negative ? -value : value);
   if (std::fabs(f) > kMaxCoordinate) return false;
   out = f;
-  p = q;
-  return true;
-}
-
-// One index of a corner written plainly: an optional '-' and at most 18 digits.
-bool parse_plain_index(const char*& p, const char* end, long long& out) {
-  const char* q = p;
-  const bool negative = q != end && *q == '-';
-  q += negative ? 1 : 0;
-  long long v = 0;
-  const char* digits = q;
-  for (; q != end && static_cast<unsigned>(*q - '0') < 10; ++q) v = v * 10 + (*q - '0');
-  if (q == digits || q - digits > 18) return false;
-  out = negative ? -v : v;
   p = q;
   return true;
 }
