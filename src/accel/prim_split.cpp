@@ -1,0 +1,386 @@
+// The binned SAH and object-median splits shared by the binary and 8-wide BVH builders.
+#include "accel/prim_split.hpp"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+namespace tracer {
+namespace {
+
+constexpr uint32_t kPartitionBlock = 16384;    // block size of the parallel passes
+constexpr uint32_t kMedianFallbackDepth = 64;  // SAH switches to object median below this depth
+constexpr int kMaxBins = 32;
+
+// Box and centroid bounds accumulated four lanes at a time; lane 3 is meaningless.
+struct Bounds4 {
+  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  __m128 clo = _mm_set1_ps(kInfinity), chi = _mm_set1_ps(-kInfinity);
+  void add(const PrimRef& r) {
+    const __m128 c = r.center();
+    lo = _mm_min_ps(lo, r.lo);
+    hi = _mm_max_ps(hi, r.hi);
+    clo = _mm_min_ps(clo, c);
+    chi = _mm_max_ps(chi, c);
+  }
+  void join(const Bounds4& o) {
+    lo = _mm_min_ps(lo, o.lo);
+    hi = _mm_max_ps(hi, o.hi);
+    clo = _mm_min_ps(clo, o.clo);
+    chi = _mm_max_ps(chi, o.chi);
+  }
+  static Aabb to_aabb(__m128 l, __m128 h) {
+    alignas(16) float a[4], b[4];
+    _mm_store_ps(a, l);
+    _mm_store_ps(b, h);
+    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
+  }
+  Aabb box() const { return to_aabb(lo, hi); }
+  Aabb centroids() const { return to_aabb(clo, chi); }
+};
+
+// Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
+// initialised, which matters because most nodes are small.
+// Four lanes (the fourth unused) so each min/max below compiles to one SSE instruction.
+struct RawBin {
+  __m128 lo, hi;
+  uint32_t count;
+  void reset() {
+    lo = _mm_set1_ps(kInfinity);
+    hi = _mm_set1_ps(-kInfinity);
+    count = 0;
+  }
+  void add(const PrimRef& r) {
+    lo = _mm_min_ps(lo, r.lo);
+    hi = _mm_max_ps(hi, r.hi);
+    ++count;
+  }
+  void add(const RawBin& o) {
+    lo = _mm_min_ps(lo, o.lo);
+    hi = _mm_max_ps(hi, o.hi);
+    count += o.count;
+  }
+  // Aabb::half_area() of a non-empty bin, summed in the same order, without leaving SSE.
+  float half_area() const {
+    const __m128 e = _mm_and_ps(_mm_sub_ps(hi, lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+    const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy, yz, zx, 0
+    const __m128 xy_yz = _mm_add_ss(p, _mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1)));
+    return _mm_cvtss_f32(_mm_add_ss(xy_yz, _mm_movehl_ps(p, p)));  // (xy + yz) + zx
+  }
+};
+
+struct BinSet {
+  int nb;
+  RawBin bins[3][kMaxBins];
+  explicit BinSet(int n) : nb(n) {
+    for (auto& axis : bins)
+      for (int b = 0; b < nb; ++b) axis[b].reset();
+  }
+  void join(const BinSet& o) {
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < nb; ++b) bins[a][b].add(o.bins[a][b]);
+  }
+};
+
+// Maps a centroid coordinate to its bin: precomputed offset and scale, no division per primitive.
+// The float clamp before truncation gives what clamping the truncated int would; both paths
+// below compute the same bin for the same centroid, which the partition relies on.
+struct Binner {
+  alignas(16) float lo[4], scale[4];
+  float top;
+  Binner(const Aabb& cbox, int bins) : top(float(bins - 1)) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = cbox.lo[a];
+      const float extent = cbox.hi[a] - cbox.lo[a];
+      scale[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
+    }
+    lo[3] = scale[3] = 0.0f;
+  }
+  int operator()(float c, int axis) const {
+    return static_cast<int>(std::min(std::max((c - lo[axis]) * scale[axis], 0.0f), top));
+  }
+  // Bins of a centroid on all three axes at once (lane 3 is 0).
+  __m128i operator()(__m128 c) const {
+    const __m128 x = _mm_mul_ps(_mm_sub_ps(c, _mm_load_ps(lo)), _mm_load_ps(scale));
+    return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(top)));
+  }
+};
+
+template <int Axis>
+uint32_t median_partition(PrimRef* refs, uint32_t begin, uint32_t end) {
+  const uint32_t mid = begin + (end - begin) / 2;
+  // Ties broken by triangle index so the order is fully defined.
+  std::nth_element(refs + begin, refs + mid, refs + end, [](const PrimRef& a, const PrimRef& b) {
+    const float ca = a.center<Axis>(), cb = b.center<Axis>();
+    return ca < cb || (ca == cb && a.id() < b.id());
+  });
+  return mid;
+}
+
+}  // namespace
+
+struct PrimSplitter::SahChoice {
+  int axis = -1;
+  int split_bin = 0;
+  float cost = 0.0f;
+  int bins = 0;
+  uint32_t left_count = 0;
+  Aabb left_box, right_box;  // the children's boxes: unions of their bins' boxes, exactly
+};
+
+// Centroid bounds of the two sides of a partition, accumulated without a branch per primitive.
+struct PrimSplitter::SideCentroids {
+  __m128 llo = _mm_set1_ps(kInfinity), lhi = _mm_set1_ps(-kInfinity);
+  __m128 rlo = _mm_set1_ps(kInfinity), rhi = _mm_set1_ps(-kInfinity);
+  void add(bool left, const PrimRef& p) {
+    const __m128 m = _mm_castsi128_ps(_mm_set1_epi32(-int32_t(left)));
+    const __m128 c = p.center();
+    const __m128 inf = _mm_set1_ps(kInfinity), ninf = _mm_set1_ps(-kInfinity);
+    llo = _mm_min_ps(llo, _mm_or_ps(_mm_and_ps(m, c), _mm_andnot_ps(m, inf)));
+    lhi = _mm_max_ps(lhi, _mm_or_ps(_mm_and_ps(m, c), _mm_andnot_ps(m, ninf)));
+    rlo = _mm_min_ps(rlo, _mm_or_ps(_mm_andnot_ps(m, c), _mm_and_ps(m, inf)));
+    rhi = _mm_max_ps(rhi, _mm_or_ps(_mm_andnot_ps(m, c), _mm_and_ps(m, ninf)));
+  }
+  void join(const SideCentroids& o) {
+    llo = _mm_min_ps(llo, o.llo);
+    lhi = _mm_max_ps(lhi, o.lhi);
+    rlo = _mm_min_ps(rlo, o.rlo);
+    rhi = _mm_max_ps(rhi, o.rhi);
+  }
+};
+
+PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+    : options_(options), exec_(exec) {
+  options_.bins = std::clamp(options_.bins, 2, kMaxBins);
+  options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
+  const auto n = static_cast<uint32_t>(scene.size());
+  // Left uninitialised: every slot is written before it is read.
+  for (auto& b : buffers_) b = std::make_unique_for_overwrite<PrimRef[]>(n);
+  PrimRef* refs = buffers_[0].get();
+  // Degenerate triangles are left out. In parallel: count per block, then fill at the offsets.
+  const auto fill = [&](uint32_t b, uint32_t e, uint32_t out) {
+    for (uint32_t i = b; i < e; ++i) {
+      if (!scene.triangles[i].degenerate()) refs[out++] = PrimRef::make(scene.triangles[i].bounds(), i);
+    }
+    return out;
+  };
+  if (!exec_.data_parallel() || n < kParallelSplit) {
+    count_ = fill(0, n, 0);
+    return;
+  }
+  const uint32_t blocks = (n + kPartitionBlock - 1) / kPartitionBlock;
+  std::vector<uint32_t> offsets(blocks + 1, 0);
+  exec_.for_each(blocks, [&](size_t k) {
+    uint32_t c = 0;
+    for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i)
+      c += scene.triangles[i].degenerate() ? 0 : 1;
+    offsets[k + 1] = c;
+  });
+  for (uint32_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
+  exec_.for_each(blocks, [&](size_t k) {
+    fill(uint32_t(k) * kPartitionBlock, std::min(n, uint32_t(k + 1) * kPartitionBlock), offsets[k]);
+  });
+  count_ = offsets[blocks];
+}
+
+void PrimSplitter::bound(PrimRange& r, bool parallel) const {
+  if (r.bounds_known) return;
+  const PrimRef* refs = buffers_[r.buffer].get();
+  const auto body = [&](uint32_t from, uint32_t to, Bounds4 acc) {
+    for (uint32_t i = from; i < to; ++i) acc.add(refs[i]);
+    return acc;
+  };
+  const Bounds4 b =
+      parallel ? exec_.reduce(r.begin, r.end, kPartitionBlock, Bounds4{}, body) : body(r.begin, r.end, Bounds4{});
+  r.box = b.box();
+  r.cbox = b.centroids();
+  r.bounds_known = true;
+}
+
+bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
+  if (is_cancelled(options_.cancel)) return false;  // the builder then throws Cancelled
+  bound(node, parallel);
+  const uint32_t begin = node.begin, end = node.end, count = end - begin;
+  PrimRef* refs = buffers_[node.buffer].get();
+  uint8_t child_buffer = node.buffer;  // partitions move the halves to the other buffer
+  uint32_t mid;
+  bool halves_known = false;
+  if (options_.split == BvhSplit::Median) {
+    if (count <= 2) return false;  // the study's leaves of one or two triangles
+    mid = median_split(refs, begin, end, static_cast<int>(node.depth % 3));
+  } else {
+    if (count <= 1) return false;
+    const Vec3 extent = node.cbox.extent();
+    if (node.depth >= kMedianFallbackDepth || max_component(extent) <= 0.0f) {
+      // Nothing to bin (all centroids equal) or pathologically deep: halve by count.
+      if (count <= uint32_t(options_.max_leaf) && max_component(extent) <= 0.0f) return false;
+      mid = median_split(refs, begin, end, max_dimension(extent));
+    } else {
+      const auto sah = sah_split(refs, node, parallel);
+      if (sah.axis < 0) {
+        if (count <= uint32_t(options_.max_leaf)) return false;
+        mid = median_split(refs, begin, end, max_dimension(extent));
+      } else {
+        const float leaf_cost = options_.intersection_cost * float(count);
+        if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
+        const Binner binner(node.cbox, sah.bins);
+        child_buffer = uint8_t(1 - node.buffer);
+        SideCentroids centroids;
+        mid = begin + sah.left_count;
+        partition(refs, buffers_[child_buffer].get(), begin, end, mid, parallel, centroids,
+                  [&](const PrimRef& prim) { return binner(prim.center(sah.axis), sah.axis) < sah.split_bin; });
+        out[0].box = sah.left_box;
+        out[1].box = sah.right_box;
+        out[0].cbox = Bounds4::to_aabb(centroids.llo, centroids.lhi);
+        out[1].cbox = Bounds4::to_aabb(centroids.rlo, centroids.rhi);
+        halves_known = true;
+      }
+    }
+  }
+  for (int c = 0; c < 2; ++c) {
+    PrimRange& h = out[c];
+    h.begin = c == 0 ? begin : mid;
+    h.end = c == 0 ? mid : end;
+    h.depth = node.depth + 1;
+    h.buffer = child_buffer;
+    h.bounds_known = halves_known;
+    bound(h, parallel && h.size() >= kParallelSplit);
+  }
+  return true;
+}
+
+uint32_t PrimSplitter::median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis) {
+  switch (axis) {
+    case 0:
+      return median_partition<0>(refs, begin, end);
+    case 1:
+      return median_partition<1>(refs, begin, end);
+    default:
+      return median_partition<2>(refs, begin, end);
+  }
+}
+
+PrimSplitter::SahChoice PrimSplitter::sah_split(const PrimRef* refs, const PrimRange& node, bool parallel) const {
+  const Aabb& cbox = node.cbox;
+  // Fewer bins than primitives buy nothing: small nodes use fewer.
+  const int nb = std::clamp(4 + int(node.end - node.begin) / 16, 4, options_.bins);
+  const Binner binner(cbox, nb);
+  const auto add = [&](const PrimRef& r, BinSet& acc) {
+    alignas(16) int32_t bin[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(bin), binner(r.center()));
+    acc.bins[0][bin[0]].add(r);
+    acc.bins[1][bin[1]].add(r);
+    acc.bins[2][bin[2]].add(r);
+  };
+  const auto fill = [&](uint32_t b, uint32_t e, BinSet& acc) {
+    if (e - b < 256) {
+      for (uint32_t i = b; i < e; ++i) add(refs[i], acc);
+      return;
+    }
+    // Neighbouring primitives often land in the same bin; alternating between two bin sets
+    // breaks the store-to-load chain through that bin. min/max and counts merge exactly.
+    BinSet odd(acc.nb);
+    uint32_t i = b;
+    for (; i + 1 < e; i += 2) {
+      add(refs[i], acc);
+      add(refs[i + 1], odd);
+    }
+    if (i < e) add(refs[i], acc);
+    acc.join(odd);
+  };
+  // Sequentially the bins are filled in place: a BinSet is kilobytes, and copying it per node
+  // costs more than the binning itself.
+  BinSet bins(nb);
+  if (parallel) {
+    bins = exec_.reduce(node.begin, node.end, kPartitionBlock, BinSet(nb), [&](uint32_t b, uint32_t e, BinSet acc) {
+      fill(b, e, acc);
+      return acc;
+    });
+  } else {
+    fill(node.begin, node.end, bins);
+  }
+  // The sweep compares the split's raw area-count sum, keeping the best in scalars selected with
+  // masks (which bin wins is unpredictable, and the compiler turned ?: back into a branch); the
+  // cost is formed once, at the end.
+  uint32_t best_choice = 0, best_left = 0;  // axis * kMaxBins + bin
+  float best_raw = kInfinity;
+  for (int a = 0; a < 3; ++a) {
+    if (cbox.hi[a] <= cbox.lo[a]) continue;
+    float right_cost[kMaxBins];  // area * count of bins [s, nb)
+    RawBin acc;
+    acc.reset();
+    for (int s = nb - 1; s > 0; --s) {
+      acc.add(bins.bins[a][s]);
+      right_cost[s] = acc.count ? acc.half_area() * float(acc.count) : kInfinity;
+    }
+    acc.reset();
+    for (int s = 1; s < nb; ++s) {
+      acc.add(bins.bins[a][s - 1]);
+      const float raw = acc.count ? acc.half_area() * float(acc.count) + right_cost[s] : kInfinity;
+      const uint32_t better = 0u - uint32_t(raw < best_raw);
+      best_raw = std::min(raw, best_raw);
+      best_choice = (uint32_t(a * kMaxBins + s) & better) | (best_choice & ~better);
+      best_left = (acc.count & better) | (best_left & ~better);
+    }
+  }
+  const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
+  SahChoice best;
+  best.axis = int(best_choice / kMaxBins);
+  best.split_bin = int(best_choice % kMaxBins);
+  best.left_count = best_left;
+  best.cost = options_.traversal_cost + options_.intersection_cost * best_raw * inv_area;
+  if (!(best_raw < kInfinity)) {
+    best.axis = -1;
+  } else {
+    RawBin l, r;
+    l.reset();
+    r.reset();
+    for (int b = 0; b < best.split_bin; ++b) l.add(bins.bins[best.axis][b]);
+    for (int b = best.split_bin; b < nb; ++b) r.add(bins.bins[best.axis][b]);
+    best.left_box = Bounds4::to_aabb(l.lo, l.hi);
+    best.right_box = Bounds4::to_aabb(r.lo, r.hi);
+  }
+  best.bins = nb;
+  return best;
+}
+
+// Stable partition of src[begin, end) into dst[begin, end) by `pred`, whose true count the
+// binning already gave (`mid` = begin + that count), gathering each side's centroid bounds on
+// the way (the boxes come from the bins) so the children need no bounds pass of their own.
+// Each primitive is stored once at a selected index: the side decides no branch, which the
+// CPU could not predict. The parallel path computes the same permutation and bounds.
+template <class Pred>
+void PrimSplitter::partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid,
+                             bool parallel, SideCentroids& out, const Pred& pred) {
+  const auto run = [&](uint32_t b, uint32_t e, uint32_t l, uint32_t r, SideCentroids& acc) {
+    for (uint32_t i = b; i < e; ++i) {
+      const PrimRef& p = src[i];
+      const bool left = pred(p);
+      dst[left ? l : r] = p;
+      l += uint32_t(left);
+      r += uint32_t(!left);
+      acc.add(left, p);
+    }
+  };
+  if (!parallel) {
+    run(begin, end, begin, mid, out);
+    return;
+  }
+  const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
+  std::vector<uint32_t> left_counts(blocks + 1, 0);
+  exec_.for_each(blocks, [&](size_t k) {
+    const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
+    uint32_t c = 0;
+    for (uint32_t i = b; i < e; ++i) c += pred(src[i]) ? 1 : 0;
+    left_counts[k + 1] = c;
+  });
+  for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
+  std::vector<SideCentroids> block(blocks);
+  exec_.for_each(blocks, [&](size_t k) {
+    const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
+    run(b, e, begin + left_counts[k], mid + (b - begin) - left_counts[k], block[k]);  // rights before this block
+  });
+  for (uint32_t k = 0; k < blocks; ++k) out.join(block[k]);
+}
+
+}  // namespace tracer

@@ -1,0 +1,95 @@
+// Splitting a set of triangles in two, as every BVH builder here does it: the binned SAH (or the
+// study's object median), over an array of primitive boxes partitioned in place of the triangles.
+// The binary BVH's builder and the 8-wide BVH's direct builder both split with this one class, so
+// a range gets the same two halves in either tree.
+//
+// Determinism: a split is a pure function of the range's primitives, and partitions are stable,
+// so every executor (sequential, forked, data-parallel) gives the same halves in the same order.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+#include <memory>
+
+#include <immintrin.h>  // SSE2, part of every x86-64
+
+#include "accel/bvh.hpp"
+
+namespace tracer {
+
+// One primitive as the builder moves it around: its box in two SSE registers, the triangle's
+// scene index in the otherwise unused fourth lane of `lo`. Binning and partitioning stream
+// through one array of these, so no pass gathers from per-triangle arrays in random order.
+struct alignas(32) PrimRef {
+  __m128 lo, hi;  // lane 3 of hi is 0
+  static PrimRef make(const Aabb& b, uint32_t id) {
+    return {_mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, std::bit_cast<float>(id)), _mm_setr_ps(b.hi.x, b.hi.y, b.hi.z, 0.0f)};
+  }
+  uint32_t id() const {
+    return std::bit_cast<uint32_t>(_mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3))));
+  }
+  // (lo + hi) / 2 per axis, as Aabb::center() computes it; lane 3 is masked off first so the
+  // id's bits never enter arithmetic (they may look like a denormal).
+  __m128 center() const {
+    const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    return _mm_mul_ps(_mm_add_ps(_mm_and_ps(lo, xyz), hi), _mm_set1_ps(0.5f));
+  }
+  template <int Axis>
+  float center() const {
+    const __m128 c = center();
+    return _mm_cvtss_f32(_mm_shuffle_ps(c, c, _MM_SHUFFLE(Axis, Axis, Axis, Axis)));
+  }
+  float center(int axis) const { return axis == 0 ? center<0>() : axis == 1 ? center<1>() : center<2>(); }
+};
+static_assert(sizeof(PrimRef) == 32);
+
+// A run [begin, end) of primitives in one of the splitter's two buffers, with its bounds once
+// known (a split computes its halves' bounds on the way, so most ranges never need a pass).
+struct PrimRange {
+  Aabb box;   // of the primitives' boxes
+  Aabb cbox;  // of their centroids
+  uint32_t begin = 0, end = 0;
+  uint32_t depth = 0;         // splits from the root: past kMedianFallbackDepth, halve by count
+  uint8_t buffer = 0;         // which buffer holds [begin, end)
+  bool bounds_known = false;  // box and cbox valid
+  uint32_t size() const { return end - begin; }
+};
+
+class PrimSplitter {
+ public:
+  // Ranges this large split their bounds, binning and partition over the executor's threads.
+  static constexpr uint32_t kParallelSplit = 65536;
+
+  // Every non-degenerate triangle of `scene`, in scene order (filled in parallel when the
+  // executor is data-parallel).
+  PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
+
+  uint32_t count() const { return count_; }
+  PrimRange root() const { return PrimRange{{}, {}, 0, count_, 0, 0, false}; }
+  const PrimRef* refs(const PrimRange& r) const { return buffers_[r.buffer].get(); }
+
+  // Computes r's bounds if not yet known.
+  void bound(PrimRange& r, bool parallel) const;
+  // Splits r (bounding it first) into out[0] and out[1], both bounded, and returns true; or
+  // returns false where r is better left a leaf (SAH: at most max_leaf primitives and cheaper
+  // whole; median: at most two) or the build is cancelled.
+  bool split(PrimRange& r, PrimRange (&out)[2], bool parallel);
+
+ private:
+  struct SahChoice;
+  struct SideCentroids;
+  SahChoice sah_split(const PrimRef* refs, const PrimRange& r, bool parallel) const;
+  uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
+  template <class Pred>
+  void partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel,
+                 SideCentroids& out, const Pred& pred);
+
+  BvhBuildOptions options_;
+  const Executor& exec_;
+  // Two buffers of count_ primitives: a partition reads a range from one and writes its halves
+  // into the other (no copy back); PrimRange::buffer says which holds a range.
+  std::unique_ptr<PrimRef[]> buffers_[2];
+  uint32_t count_ = 0;
+};
+
+}  // namespace tracer
