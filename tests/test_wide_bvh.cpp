@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <functional>
 #include <random>
 
@@ -119,6 +121,147 @@ TEST(WideBvh, DegenerateInputs) {
     EXPECT_EQ(wide.occluded(r), !tris.empty());
     if (!tris.empty()) {
       EXPECT_EQ(h.tri, 0u);
+    }
+  }
+}
+
+// Many spheres in a row: enough triangles (about 150k) that the top splits run data-parallel.
+Scene many_spheres() {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  for (int i = 0; i < 12; ++i) {
+    const IndexedMesh m = make_uv_sphere({float(i) * 1.5f, float(i % 3), 0.0f}, 1.0f + 0.1f * float(i), 160, 40);
+    scene.add_mesh("sphere", m.vertices, m.indices, 0);
+  }
+  scene.finalize();
+  return scene;
+}
+
+// One wide node as a list of its children: box, and the sorted triangles below it.
+struct WideChild {
+  std::array<float, 6> box;  // lo, hi
+  std::vector<uint32_t> tris;
+  bool leaf;
+  bool operator==(const WideChild&) const = default;
+};
+using WideShape = std::vector<std::vector<WideChild>>;  // nodes depth first
+
+void collect(const WideBvh& w, uint32_t node, std::vector<uint32_t>& out) {
+  const WideNode& n = w.nodes()[node];
+  for (int i = 0; i < kWideWidth && n.lo_x[i] <= n.hi_x[i]; ++i) {
+    if (n.count[i] == 0) {
+      collect(w, n.child[i], out);
+    } else {
+      out.insert(out.end(), w.packs()[n.child[i]].id, w.packs()[n.child[i]].id + n.count[i]);
+    }
+  }
+}
+
+void shape_of(const WideBvh& w, uint32_t node, WideShape& shape) {
+  const WideNode& n = w.nodes()[node];
+  const size_t self = shape.size();
+  shape.emplace_back();
+  for (int i = 0; i < kWideWidth && n.lo_x[i] <= n.hi_x[i]; ++i) {
+    WideChild c{{n.lo_x[i], n.lo_y[i], n.lo_z[i], n.hi_x[i], n.hi_y[i], n.hi_z[i]}, {}, n.count[i] != 0};
+    if (c.leaf) {
+      c.tris.assign(w.packs()[n.child[i]].id, w.packs()[n.child[i]].id + n.count[i]);
+    } else {
+      collect(w, n.child[i], c.tris);
+    }
+    std::sort(c.tris.begin(), c.tris.end());
+    const bool leaf = c.leaf;
+    shape[self].push_back(std::move(c));
+    if (!leaf) shape_of(w, n.child[i], shape);
+  }
+}
+
+// The reference: the binary SAH tree (leaves of up to eight) collapsed greedily, as the 8-wide
+// tree was once built: open the inner node with the largest box until eight children remain or
+// only subtrees of at most eight triangles, largest subtree first; those become packs.
+struct Collapse {
+  const Bvh& bin;
+  uint32_t count(uint32_t i) const {
+    const BvhNode& n = bin.nodes()[i];
+    return n.leaf() ? n.count : count(n.index) + count(n.index + 1);
+  }
+  void tris(uint32_t i, std::vector<uint32_t>& out) const {
+    const BvhNode& n = bin.nodes()[i];
+    if (!n.leaf()) return tris(n.index, out), tris(n.index + 1, out);
+    out.insert(out.end(), bin.triangle_ids().begin() + n.index, bin.triangle_ids().begin() + n.index + n.count);
+  }
+  void shape(uint32_t root, WideShape& out) const {
+    const auto packable = [&](uint32_t i) { return count(i) <= uint32_t(kWideWidth); };
+    std::vector<uint32_t> kids{root};
+    if (!packable(root)) kids = {bin.nodes()[root].index, bin.nodes()[root].index + 1};
+    while (kids.size() < size_t(kWideWidth)) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (size_t i = 0; i < kids.size(); ++i) {
+        const BvhNode& n = bin.nodes()[kids[i]];
+        if (!packable(kids[i]) && Aabb{n.lo, n.hi}.half_area() > best_area) {
+          best = int(i);
+          best_area = Aabb{n.lo, n.hi}.half_area();
+        }
+      }
+      if (best < 0) break;
+      const uint32_t first = bin.nodes()[kids[size_t(best)]].index;
+      kids[size_t(best)] = first;
+      kids.insert(kids.begin() + best + 1, first + 1);
+    }
+    std::stable_sort(kids.begin(), kids.end(), [&](uint32_t a, uint32_t b) { return count(a) > count(b); });
+    const size_t self = out.size();
+    out.emplace_back();
+    for (const uint32_t k : kids) {
+      const BvhNode& n = bin.nodes()[k];
+      WideChild c{{n.lo.x, n.lo.y, n.lo.z, n.hi.x, n.hi.y, n.hi.z}, {}, packable(k)};
+      tris(k, c.tris);
+      std::sort(c.tris.begin(), c.tris.end());
+      out[self].push_back(std::move(c));
+      if (!packable(k)) shape(k, out);
+    }
+  }
+};
+
+// The direct build gives the tree the greedy collapse of the binary SAH tree gives (same nodes,
+// boxes and packs, depth first), so it is no worse a tree; SAH and median splits.
+TEST(WideBvh, DirectBuildGivesTheCollapsedBinaryTree) {
+  std::vector<Scene> scenes = agreement_scenes();
+  scenes.push_back(many_spheres());
+  for (const Scene& scene : scenes) {
+    SCOPED_TRACE(scene.source);
+    for (const BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
+      BvhBuildOptions options;
+      options.split = split;
+      const WideBvh wide(scene, options);
+      options.max_leaf = kWideWidth;
+      const Bvh bin(scene, options);
+      WideShape direct, collapsed;
+      shape_of(wide, 0, direct);
+      Collapse{bin}.shape(0, collapsed);
+      ASSERT_EQ(direct.size(), collapsed.size());
+      EXPECT_TRUE(direct == collapsed);
+    }
+  }
+}
+
+// Every executor and thread count builds the same tree, byte for byte.
+TEST(WideBvh, SameTreeUnderEveryExecutorAndThreadCount) {
+  const Scene scene = many_spheres();
+  ASSERT_GT(scene.size(), 100'000u);
+  BvhBuildOptions options;
+  options.mode = BuildMode::Seq;
+  const WideBvh ref(scene, options);
+  EXPECT_EQ(ref.validate(), "");
+  for (const BuildMode mode : {BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+    for (const int threads : {1, 2, 4}) {
+      SCOPED_TRACE(testing::Message() << int(mode) << " " << threads);
+      options.mode = mode;
+      options.threads = threads;
+      const WideBvh w(scene, options);
+      ASSERT_EQ(w.nodes().size(), ref.nodes().size());
+      ASSERT_EQ(w.packs().size(), ref.packs().size());
+      EXPECT_EQ(std::memcmp(w.nodes().data(), ref.nodes().data(), ref.nodes().size() * sizeof(WideNode)), 0);
+      EXPECT_EQ(std::memcmp(w.packs().data(), ref.packs().data(), ref.packs().size() * sizeof(TrianglePack)), 0);
     }
   }
 }

@@ -100,16 +100,6 @@ struct BvhStats {
 
 struct RayBoxTest;
 
-// The binary tree alone, in the flat layout (nodes[0] the root, nodes[1] padding, children pairs
-// adjacent; a leaf's triangles are ids[index, index + count)): what the 8-wide BVH collapses,
-// without the reordered triangles and the parent and leaf tables only the binary tree's own
-// traversal reads (on the 5.1M-triangle scene, 225 MB the 8-wide build no longer holds).
-struct BvhTopology {
-  BvhNodeArray nodes;
-  std::vector<uint32_t> ids;  // scene triangle of each leaf slot
-};
-BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
-
 // The executor strategy of a build mode (tasks: oneTBB).
 Strategy strategy_for(BuildMode mode);
 

@@ -190,17 +190,6 @@ Strategy strategy_for(BuildMode mode) {
   return Strategy::Tbb;
 }
 
-BvhTopology build_bvh_topology(const Scene& scene, const BvhBuildOptions& options, const Executor& exec) {
-  BvhTopology t;
-  exec.run([&] {
-    BvhBuilder builder(scene, options, exec);
-    builder.build();
-    builder.flatten(t.nodes, t.ids, nullptr, nullptr);
-  });
-  throw_if_cancelled(options.cancel);
-  return t;
-}
-
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options)
     : Bvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
 

@@ -1,4 +1,4 @@
-// 8-wide BVH collapsed from the binary SAH tree: each node holds its children's boxes as SoA
+// 8-wide BVH built directly by the binned SAH: each node holds its children's boxes as SoA
 // arrays so one SIMD pass tests a ray against all eight, and children are visited nearest first.
 // The box kernel is compiled for SSE4, AVX2 and AVX-512 with Google Highway and chosen at run
 // time for the CPU it runs on; leaves use the same watertight triangle test as everything else,
@@ -46,8 +46,8 @@ using PackArray = std::vector<TrianglePack, CacheAlignedAllocator<TrianglePack>>
 
 class WideBvh {
  public:
-  // Builds the binary SAH tree with `options` (leaves of up to eight triangles: one pack), then
-  // collapses it.
+  // Builds the tree with `options` (split and executor; leaves are packs of up to eight
+  // triangles) directly, 8-wide: wide_bvh_build.cpp.
   WideBvh(const Scene& scene, const BvhBuildOptions& options);
   WideBvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 

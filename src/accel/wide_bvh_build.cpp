@@ -1,125 +1,204 @@
-// Building the 8-wide BVH: the binary SAH tree collapsed into 8-wide nodes, leaves packed.
+// Building the 8-wide BVH directly: each node takes its primitives, splits the child with the
+// largest box (by the same binned SAH as the binary tree, PrimSplitter) until it has eight
+// children or every child fits one pack, then builds its inner children, in parallel where they
+// are large. This is the tree the binary SAH tree collapsed greedily would give, without building
+// the binary tree's lower levels, its flat array, or the collapse.
+//
+// Determinism: splits do not depend on scheduling, and the nodes, written into a scratch array in
+// whatever order threads reach them, are copied depth-first into their final places.
 #include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <stdexcept>
 #include <vector>
 
+#include "accel/prim_split.hpp"
 #include "accel/wide_bvh.hpp"
 
 namespace tracer {
 
 namespace {
 
-// Collapses the binary subtree under `root` into wide nodes, appending to `out`; returns the
-// index of the wide node made for `root`.
-class Collapser {
+constexpr uint32_t kParallelSubtree = 4096;  // below this a subtree is built by one thread
+constexpr size_t kPackBlock = 1024;          // packs filled per parallel item
+
+class WideBuilder {
  public:
-  Collapser(const BvhTopology& bin, const Scene& scene, std::vector<WideNode>& out, PackArray& packs)
-      : bin_(bin), scene_(scene), out_(out), packs_(packs), first_(bin.nodes.size()), count_(bin.nodes.size()) {
-    // Each binary subtree's triangles are one contiguous run (the builder lays leaves out in
-    // depth-first order); record it, children before parents (children have larger indices).
-    const auto& nodes = bin.nodes;
-    for (size_t i = nodes.size(); i-- > 0;) {
-      if (i == 1) continue;  // padding
-      const BvhNode& n = nodes[i];
-      first_[i] = n.leaf() ? n.index : first_[n.index];
-      count_[i] = n.leaf() ? n.count : count_[n.index] + count_[n.index + 1];
-    }
+  WideBuilder(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+      : scene_(scene), options_(options), exec_(exec), splitter_(scene, options, exec) {
+    // Every inner node holds more than one pack's primitives and at least two children, and one
+    // with fewer than eight has only packs below it, so n primitives make fewer than n/2 + 2.
+    capacity_ = splitter_.count() / 2 + 2;
+    // Left uninitialised: only the nodes taken are touched.
+    scratch_.reset(static_cast<WideNode*>(std::aligned_alloc(alignof(WideNode), capacity_ * sizeof(WideNode))));
+    if (!scratch_) throw std::bad_alloc();
   }
 
-  uint32_t collapse(uint32_t root) {
-    // Open the largest inner node until eight children (or only leaves) remain: keeps the
-    // children's total surface area, and so the expected cost, as low as greedy can.
-    std::vector<uint32_t> kids{root};
-    if (!packable(root)) kids = {bin_.nodes[root].index, bin_.nodes[root].index + 1};
-    while (kids.size() < size_t(kWideWidth)) {
+  // Builds the tree into `nodes` and `packs`; returns the bounds of everything in it.
+  Aabb build(std::vector<WideNode>& nodes, PackArray& packs) {
+    if (splitter_.count() == 0) return Aabb{};
+    PrimRange root = splitter_.root();
+    splitter_.bound(root, exec_.data_parallel() && root.size() >= PrimSplitter::kParallelSplit);
+    used_ = 1;
+    build_node(root, 0);
+    throw_if_cancelled(options_.cancel);
+    if (failed_) throw std::logic_error("8-wide BVH build: a node of more than one pack could not be split");
+    nodes.clear();
+    nodes.reserve(used_);
+    place(0, nodes);
+    fill_packs(packs);
+    return root.box;
+  }
+
+ private:
+  static bool packable(const PrimRange& r) { return r.size() <= uint32_t(kWideWidth); }
+  bool parallel_split(const PrimRange& r) const {
+    return exec_.data_parallel() && r.size() >= PrimSplitter::kParallelSplit;
+  }
+
+  // Builds the node for `range` into scratch_[self] and, below it, its inner children.
+  void build_node(PrimRange range, uint32_t self) {
+    // Open the largest child until eight children (or only packs) remain: keeps the children's
+    // total surface area, and so the expected cost, as low as greedy can.
+    PrimRange kids[kWideWidth];
+    int count = 1;
+    kids[0] = range;
+    if (!packable(range) && !open(kids, count, 0)) return;
+    while (count < kWideWidth) {
       int best = -1;
       float best_area = -1.0f;
-      for (size_t i = 0; i < kids.size(); ++i) {
-        const BvhNode& n = bin_.nodes[kids[i]];
-        const float area = Aabb{n.lo, n.hi}.half_area();
+      for (int i = 0; i < count; ++i) {
+        const float area = kids[i].box.half_area();
         if (!packable(kids[i]) && area > best_area) {
-          best = int(i);
+          best = i;
           best_area = area;
         }
       }
       if (best < 0) break;
-      const BvhNode& n = bin_.nodes[kids[size_t(best)]];
-      kids[size_t(best)] = n.index;
-      kids.insert(kids.begin() + best + 1, n.index + 1);
+      if (!open(kids, count, best)) return;
     }
     // Largest subtree (in triangles) first. Any-hit traversal enters the last slot first, so it
     // tries the smallest subtrees first: few triangles spanning a box as large as their siblings'
     // are large triangles (walls, floors), the likeliest occluders. Embree's builder orders its
     // children the same way. On Sponza's AO rays: 29 % fewer nodes and 7x fewer L1 misses per ray
     // (docs/bench/LOG.md).
-    std::stable_sort(kids.begin(), kids.end(), [&](uint32_t a, uint32_t b) { return count_[a] > count_[b]; });
-    const auto self = static_cast<uint32_t>(out_.size());
-    out_.emplace_back();
-    {
-      WideNode& w = out_[self];
-      for (int i = 0; i < kWideWidth; ++i) {
-        w.lo_x[i] = w.lo_y[i] = w.lo_z[i] = kInfinity;
-        w.hi_x[i] = w.hi_y[i] = w.hi_z[i] = -kInfinity;
-        w.child[i] = 0;
-        w.count[i] = 0;
+    std::stable_sort(kids, kids + count, [](const PrimRange& a, const PrimRange& b) { return a.size() > b.size(); });
+    WideNode& w = scratch_[self];
+    PrimRange inner[kWideWidth];
+    uint32_t inner_slot[kWideWidth];
+    int inner_count = 0;
+    for (int i = 0; i < kWideWidth; ++i) {
+      const bool used = i < count;
+      const Aabb& b = kids[i].box;
+      w.lo_x[i] = used ? b.lo.x : kInfinity;
+      w.lo_y[i] = used ? b.lo.y : kInfinity;
+      w.lo_z[i] = used ? b.lo.z : kInfinity;
+      w.hi_x[i] = used ? b.hi.x : -kInfinity;
+      w.hi_y[i] = used ? b.hi.y : -kInfinity;
+      w.hi_z[i] = used ? b.hi.z : -kInfinity;
+      w.child[i] = used ? 0 : kInvalidIndex;  // in scratch, an empty slot; 0 once placed
+      w.count[i] = 0;
+      if (!used) continue;
+      if (packable(kids[i])) {
+        // A leaf, in scratch: its first primitive and, above the count, which buffer holds it.
+        w.child[i] = kids[i].begin;
+        w.count[i] = kids[i].size() | uint32_t(kids[i].buffer) << 8;
+      } else {
+        w.child[i] = used_.fetch_add(1, std::memory_order_relaxed);
+        inner[inner_count] = kids[i];
+        inner_slot[inner_count++] = w.child[i];
       }
     }
-    for (size_t i = 0; i < kids.size(); ++i) {
-      const BvhNode& n = bin_.nodes[kids[i]];
-      uint32_t child = 0, count = 0;
-      if (packable(kids[i])) {
-        count = count_[kids[i]];
-        child = make_pack(first_[kids[i]], count);
+    build_nodes(inner, inner_slot, inner_count);
+  }
+
+  // Builds nodes for ranges[0, n) into their slots: large groups as two forked halves.
+  void build_nodes(const PrimRange* ranges, const uint32_t* slots, int n) {
+    if (n == 0) return;
+    if (n == 1) return build_node(ranges[0], slots[0]);
+    uint64_t total = 0;
+    for (int i = 0; i < n; ++i) total += ranges[i].size();
+    if (!exec_.forks() || total < kParallelSubtree) {
+      for (int i = 0; i < n; ++i) build_node(ranges[i], slots[i]);
+      return;
+    }
+    const int half = n / 2;
+    exec_.fork_join([&] { build_nodes(ranges, slots, half); },
+                    [&] { build_nodes(ranges + half, slots + half, n - half); });
+  }
+
+  // Replaces kids[i] by its two halves (kids[i], kids[i + 1]); false if it could not be split
+  // (the build was cancelled).
+  bool open(PrimRange* kids, int& count, int i) {
+    PrimRange halves[2];
+    if (!splitter_.split(kids[i], halves, parallel_split(kids[i]))) {
+      if (!is_cancelled(options_.cancel)) failed_ = true;
+      return false;
+    }
+    std::copy_backward(kids + i + 1, kids + count, kids + count + 1);
+    kids[i] = halves[0];
+    kids[i + 1] = halves[1];
+    ++count;
+    return true;
+  }
+
+  // Copies scratch node `s` and its subtree, depth first, to the end of `out`, numbering packs
+  // in the same order; returns its index there.
+  uint32_t place(uint32_t s, std::vector<WideNode>& out) {
+    const auto self = static_cast<uint32_t>(out.size());
+    out.push_back(scratch_[s]);
+    for (int i = 0; i < kWideWidth; ++i) {
+      const uint32_t child = out[self].child[i], count = out[self].count[i];
+      if (count == 0 && child == kInvalidIndex) {
+        out[self].child[i] = 0;
+      } else if (count != 0) {
+        out[self].child[i] = static_cast<uint32_t>(runs_.size());
+        out[self].count[i] = count & 0xff;
+        runs_.push_back({child, count & 0xff, uint8_t(count >> 8)});
       } else {
-        child = collapse(kids[i]);  // may reallocate out_: index, not reference
+        const uint32_t placed = place(child, out);  // may reallocate out: index, not reference
+        out[self].child[i] = placed;
       }
-      WideNode& w = out_[self];
-      w.lo_x[i] = n.lo.x;
-      w.lo_y[i] = n.lo.y;
-      w.lo_z[i] = n.lo.z;
-      w.hi_x[i] = n.hi.x;
-      w.hi_y[i] = n.hi.y;
-      w.hi_z[i] = n.hi.z;
-      w.child[i] = child;
-      w.count[i] = count;
     }
     return self;
   }
 
- private:
-  // A subtree of at most one pack's worth of triangles becomes one leaf: testing eight lanes
-  // costs about what one more level of boxes would, and saves that level's loads.
-  bool packable(uint32_t node) const { return count_[node] <= uint32_t(kWideWidth); }
-
-  // Leaves are numbered here and filled afterwards, in parallel (fill_packs): filling gathers
-  // each triangle from the scene, a cache miss per triangle on large scenes.
-  uint32_t make_pack(uint32_t first, uint32_t count) {
-    pack_runs_.push_back({first, count});
-    return static_cast<uint32_t>(pack_runs_.size() - 1);
-  }
-
- public:
-  void fill_packs(const Executor& exec) {
-    packs_.resize(pack_runs_.size());
+  // Fills the packs from the primitive runs, in parallel: each gathers its triangles from the
+  // scene, a cache miss per triangle on large scenes.
+  void fill_packs(PackArray& packs) const {
+    packs.resize(runs_.size());
     const auto fill = [&](size_t begin, size_t end) {
-      for (size_t k = begin; k < end; ++k)
-        packs_[k] = make_triangle_pack(scene_.triangles, bin_.ids, pack_runs_[k].first, pack_runs_[k].count);
+      for (size_t k = begin; k < end; ++k) {
+        const Run& r = runs_[k];
+        const PrimRef* refs = splitter_.refs(PrimRange{{}, {}, 0, 0, 0, r.buffer, false});
+        uint32_t ids[kWideWidth];
+        for (uint32_t j = 0; j < r.count; ++j) ids[j] = refs[r.first + j].id();
+        packs[k] = make_triangle_pack(scene_.triangles, ids, 0, r.count);
+      }
     };
-    constexpr size_t kBlock = 1024;
-    const auto blocks = uint32_t((pack_runs_.size() + kBlock - 1) / kBlock);
-    if (!exec.data_parallel() || blocks < 2) return fill(0, pack_runs_.size());
-    exec.for_each(blocks, [&](size_t b) { fill(b * kBlock, std::min(pack_runs_.size(), (b + 1) * kBlock)); });
+    const auto blocks = uint32_t((runs_.size() + kPackBlock - 1) / kPackBlock);
+    if (!exec_.data_parallel() || blocks < 2) return fill(0, runs_.size());
+    exec_.for_each(blocks, [&](size_t b) { fill(b * kPackBlock, std::min(runs_.size(), (b + 1) * kPackBlock)); });
   }
 
- private:
-  const BvhTopology& bin_;
-  const Scene& scene_;
-  std::vector<WideNode>& out_;
-  PackArray& packs_;
-  std::vector<uint32_t> first_, count_;  // per binary node: its subtree's triangle run
+  struct FreeNodes {
+    void operator()(WideNode* p) const { std::free(p); }
+  };
   struct Run {
     uint32_t first, count;
+    uint8_t buffer;
   };
-  std::vector<Run> pack_runs_;  // per pack: its triangles' run in bin_.ids
+
+  const Scene& scene_;
+  const BvhBuildOptions& options_;
+  const Executor& exec_;
+  PrimSplitter splitter_;
+  size_t capacity_ = 0;
+  std::unique_ptr<WideNode[], FreeNodes> scratch_;
+  std::atomic<uint32_t> used_{0};
+  std::atomic<bool> failed_{false};
+  std::vector<Run> runs_;  // per pack, in its final order
 };
 
 }  // namespace
@@ -129,14 +208,12 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
 
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec) : scene_(&scene) {
   BvhBuildOptions options = options_in;
+  // Nodes of more than one pack are always split, so the SAH never weighs a leaf larger than one.
   options.max_leaf = std::min(options.max_leaf, kWideWidth);
-  const BvhTopology binary = build_bvh_topology(scene, options, exec);
-  if (binary.nodes.empty()) return;
-  nodes_.reserve(binary.nodes.size() / 4 + 1);
-  Collapser collapser(binary, scene, nodes_, packs_);
-  collapser.collapse(0);
-  exec.run([&] { collapser.fill_packs(exec); });
-  bounds_ = Aabb{binary.nodes[0].lo, binary.nodes[0].hi};
+  exec.run([&] {
+    WideBuilder builder(scene, options, exec);
+    bounds_ = builder.build(nodes_, packs_);
+  });
 }
 
 }  // namespace tracer
