@@ -10,6 +10,7 @@
 #include "accel/accelerator.hpp"
 #ifdef TRACER_HAVE_EMBREE
 #include "accel/embree_accel.hpp"
+#include "base/huge_pages.hpp"
 #endif
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
@@ -386,6 +387,33 @@ TEST(BvhAgreement, EmbreePacketsWithUnusedLanesOnItsAvx2Kernels) {
   }
 }
 #endif
+
+}  // namespace
+}  // namespace tracer
+
+namespace tracer {
+namespace {
+
+// Arrays for the trees: small ones from the heap, 64-byte aligned; large ones their own 2 MiB
+// aligned mapping (huge pages where the kernel gives them); growing keeps the contents.
+TEST(LargeArrays, AlignedWritableAndGrowable) {
+  for (const size_t bytes : {size_t(0), size_t(100), kHugeArrayMinBytes - 1, kHugeArrayMinBytes, size_t(9) << 20}) {
+    SCOPED_TRACE(bytes);
+    LargeBuffer<unsigned char> b(bytes);
+    const auto at = reinterpret_cast<uintptr_t>(b.get());
+    EXPECT_EQ(at % 64, 0u);
+    if (bytes >= kHugeArrayMinBytes) EXPECT_EQ(at % kHugePageBytes, 0u);
+    for (size_t i = 0; i < bytes; ++i) b[i] = static_cast<unsigned char>(i * 7);
+    size_t wrong = 0;
+    for (size_t i = 0; i < bytes; ++i) wrong += b[i] != static_cast<unsigned char>(i * 7) ? 1 : 0;
+    EXPECT_EQ(wrong, 0u);
+  }
+  std::vector<uint32_t, LargeArrayAllocator<uint32_t>> v;
+  for (uint32_t i = 0; i < 3'000'000; ++i) v.push_back(i);  // crosses into mappings and grows within them
+  size_t wrong = 0;
+  for (uint32_t i = 0; i < v.size(); ++i) wrong += v[i] != i ? 1 : 0;
+  EXPECT_EQ(wrong, 0u);
+}
 
 }  // namespace
 }  // namespace tracer

@@ -15,6 +15,7 @@
 #include "accel/triangle_test.hpp"
 #include "base/enum_names.hpp"
 #include "base/errors.hpp"
+#include "base/huge_pages.hpp"
 #include "math/aabb.hpp"
 #include "math/ray_packet.hpp"
 #include "parallel/executor.hpp"
@@ -64,33 +65,9 @@ inline void prefetch_child(const BvhNode& c, const BvhNode* nodes, const Triangl
   __builtin_prefetch(reinterpret_cast<const void*>((tri_line & leaf) | (node_line & ~leaf)));
 }
 
-// Cache-line aligned storage: with sibling pairs at even indices, each pair is one 64-byte line.
-template <class T>
-struct CacheAlignedAllocator {
-  using value_type = T;
-  CacheAlignedAllocator() = default;
-  template <class U>
-  CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{64})); }
-  void deallocate(T* p, size_t) { ::operator delete (p, std::align_val_t{64}); }
-  // resize() leaves new elements uninitialised (they are plain implicit-lifetime aggregates the
-  // builder overwrites, in parallel): zeroing megabytes first cost as much as the flattening.
-  template <class U>
-  void construct(U*) noexcept {
-    static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>);
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-  template <class U>
-  bool operator==(const CacheAlignedAllocator<U>&) const {
-    return true;
-  }
-};
-
-using BvhNodeArray = std::vector<BvhNode, CacheAlignedAllocator<BvhNode>>;
-using TriangleArray = std::vector<Triangle, CacheAlignedAllocator<Triangle>>;
+// Cache-line aligned (sibling pairs at even indices are one 64-byte line), on huge pages when large.
+using BvhNodeArray = std::vector<BvhNode, LargeArrayAllocator<BvhNode>>;
+using TriangleArray = std::vector<Triangle, LargeArrayAllocator<Triangle>>;
 
 struct BvhStats {
   size_t nodes = 0, leaves = 0, max_depth = 0, max_leaf_size = 0;

@@ -155,7 +155,7 @@ PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, c
   options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
   const auto n = static_cast<uint32_t>(scene.size());
   // Left uninitialised: every slot is written before it is read.
-  for (auto& b : buffers_) b = std::make_unique_for_overwrite<PrimRef[]>(n);
+  for (auto& b : buffers_) b = LargeBuffer<PrimRef>(n);
   PrimRef* refs = buffers_[0].get();
   // Degenerate triangles are left out. In parallel: count per block, then fill at the offsets.
   const auto fill = [&](uint32_t b, uint32_t e, uint32_t out) {

@@ -9,11 +9,11 @@
 
 #include <bit>
 #include <cstdint>
-#include <memory>
 
 #include <immintrin.h>  // SSE2, part of every x86-64
 
 #include "accel/bvh.hpp"
+#include "base/huge_pages.hpp"
 
 namespace tracer {
 
@@ -88,7 +88,7 @@ class PrimSplitter {
   const Executor& exec_;
   // Two buffers of count_ primitives: a partition reads a range from one and writes its halves
   // into the other (no copy back); PrimRange::buffer says which holds a range.
-  std::unique_ptr<PrimRef[]> buffers_[2];
+  LargeBuffer<PrimRef> buffers_[2];
   uint32_t count_ = 0;
 };
 

@@ -41,8 +41,10 @@ struct alignas(64) TrianglePack {
   uint32_t id[kWideWidth];
 };
 
-// Packs, 64-byte aligned, left uninitialised by resize() (the build fills them in parallel).
-using PackArray = std::vector<TrianglePack, CacheAlignedAllocator<TrianglePack>>;
+// Packs and nodes, 64-byte aligned, on huge pages when large; packs are left uninitialised by
+// resize() (the build fills them in parallel).
+using PackArray = std::vector<TrianglePack, LargeArrayAllocator<TrianglePack>>;
+using WideNodeArray = std::vector<WideNode, LargeArrayAllocator<WideNode>>;
 
 class WideBvh {
  public:
@@ -63,7 +65,7 @@ class WideBvh {
   // needed by this tree; the binary BVH starts from it.
   uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
 
-  const std::vector<WideNode>& nodes() const { return nodes_; }
+  const WideNodeArray& nodes() const { return nodes_; }
   const PackArray& packs() const { return packs_; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const { return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack); }
@@ -82,7 +84,7 @@ class WideBvh {
 
  private:
   const Scene* scene_;
-  std::vector<WideNode> nodes_;
+  WideNodeArray nodes_;
   PackArray packs_;
   Aabb bounds_;
 };

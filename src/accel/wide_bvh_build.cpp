@@ -31,12 +31,11 @@ class WideBuilder {
     // with fewer than eight has only packs below it, so n primitives make fewer than n/2 + 2.
     capacity_ = splitter_.count() / 2 + 2;
     // Left uninitialised: only the nodes taken are touched.
-    scratch_.reset(static_cast<WideNode*>(std::aligned_alloc(alignof(WideNode), capacity_ * sizeof(WideNode))));
-    if (!scratch_) throw std::bad_alloc();
+    scratch_ = LargeBuffer<WideNode>(capacity_);
   }
 
   // Builds the tree into `nodes` and `packs`; returns the bounds of everything in it.
-  Aabb build(std::vector<WideNode>& nodes, PackArray& packs) {
+  Aabb build(WideNodeArray& nodes, PackArray& packs) {
     if (splitter_.count() == 0) return Aabb{};
     PrimRange root = splitter_.root();
     splitter_.bound(root, exec_.data_parallel() && root.size() >= PrimSplitter::kParallelSplit);
@@ -145,7 +144,7 @@ class WideBuilder {
 
   // Copies scratch node `s` and its subtree, depth first, to the end of `out`, numbering packs
   // in the same order; returns its index there.
-  uint32_t place(uint32_t s, std::vector<WideNode>& out) {
+  uint32_t place(uint32_t s, WideNodeArray& out) {
     const auto self = static_cast<uint32_t>(out.size());
     out.push_back(scratch_[s]);
     for (int i = 0; i < kWideWidth; ++i) {
@@ -182,9 +181,6 @@ class WideBuilder {
     exec_.for_each(blocks, [&](size_t b) { fill(b * kPackBlock, std::min(runs_.size(), (b + 1) * kPackBlock)); });
   }
 
-  struct FreeNodes {
-    void operator()(WideNode* p) const { std::free(p); }
-  };
   struct Run {
     uint32_t first, count;
     uint8_t buffer;
@@ -195,7 +191,7 @@ class WideBuilder {
   const Executor& exec_;
   PrimSplitter splitter_;
   size_t capacity_ = 0;
-  std::unique_ptr<WideNode[], FreeNodes> scratch_;
+  LargeBuffer<WideNode> scratch_;
   std::atomic<uint32_t> used_{0};
   std::atomic<bool> failed_{false};
   std::vector<Run> runs_;  // per pack, in its final order
