@@ -9,6 +9,7 @@
 #include <new>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace tracer {
 
@@ -21,17 +22,29 @@ inline constexpr size_t kHugeArrayMinBytes = size_t(1) << 20;
 void* allocate_large(size_t bytes);
 void free_large(void* p, size_t bytes) noexcept;
 
-// A std::allocator for large arrays of plain data: cache-line aligned, on huge pages when large,
-// and resize() leaves new elements uninitialised (they are implicit-lifetime aggregates the
-// caller overwrites, often in parallel: zeroing them first costs a pass over the memory).
+// A std::allocator on allocate_large: cache-line aligned, on huge pages when large.
 template <class T>
-struct LargeArrayAllocator {
+struct HugePageAllocator {
   using value_type = T;
+  HugePageAllocator() = default;
+  template <class U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  T* allocate(size_t n) { return static_cast<T*>(allocate_large(n * sizeof(T))); }
+  void deallocate(T* p, size_t n) noexcept { free_large(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const HugePageAllocator<U>&) const {
+    return true;
+  }
+};
+
+// HugePageAllocator for arrays of plain data whose resize() leaves new elements uninitialised
+// (implicit-lifetime aggregates the caller overwrites, often in parallel: zeroing them first
+// costs a pass over the memory).
+template <class T>
+struct LargeArrayAllocator : HugePageAllocator<T> {
   LargeArrayAllocator() = default;
   template <class U>
   LargeArrayAllocator(const LargeArrayAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(allocate_large(n * sizeof(T))); }
-  void deallocate(T* p, size_t n) noexcept { free_large(p, n * sizeof(T)); }
   template <class U>
   void construct(U*) noexcept {
     static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>);
@@ -40,11 +53,11 @@ struct LargeArrayAllocator {
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
-  template <class U>
-  bool operator==(const LargeArrayAllocator<U>&) const {
-    return true;
-  }
 };
+
+// A vector on HugePageAllocator, value-initialising as std::vector does.
+template <class T>
+using LargeVector = std::vector<T, HugePageAllocator<T>>;
 
 // A fixed-size array of T from allocate_large, left uninitialised.
 template <class T>

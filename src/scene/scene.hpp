@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "base/huge_pages.hpp"
 #include "base/invalid_index.hpp"
 #include "math/aabb.hpp"
 #include "math/vec.hpp"
@@ -85,16 +86,16 @@ struct CameraSpec {
 
 struct Scene {
   std::string source;  // file path or built-in name
-  std::vector<Triangle> triangles;
-  std::vector<uint32_t> tri_geom;      // geomID per triangle
-  std::vector<uint32_t> tri_prim;      // primID per triangle
-  std::vector<uint32_t> tri_material;  // index into materials
+  LargeVector<Triangle> triangles;
+  LargeVector<uint32_t> tri_geom;      // geomID per triangle
+  LargeVector<uint32_t> tri_prim;      // primID per triangle
+  LargeVector<uint32_t> tri_material;  // index into materials
   // Shading normals from the file's `vn`, three per triangle (corner order), or empty when it has
   // none; zero at the corners of faces that give none. The ao workload shades with the geometric
   // normal; whitted interpolates these.
-  std::vector<Vec3> corner_normals;
+  LargeVector<Vec3> corner_normals;
   // Texture coordinates from the file's `vt`, three per triangle, or empty when it has none.
-  std::vector<Vec2> corner_uvs;
+  LargeVector<Vec2> corner_uvs;
   std::vector<Texture> textures;
   std::vector<Geometry> geometries;
   std::vector<Material> materials;

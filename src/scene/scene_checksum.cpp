@@ -22,8 +22,8 @@ class Fnv1a {
     static_assert(std::is_trivially_copyable_v<T>);
     bytes(&v, sizeof v);
   }
-  template <class T>
-  void array(const std::vector<T>& v) {
+  template <class T, class A>
+  void array(const std::vector<T, A>& v) {
     value(uint64_t(v.size()));
     if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
   }
