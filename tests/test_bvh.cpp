@@ -402,7 +402,9 @@ TEST(LargeArrays, AlignedWritableAndGrowable) {
     LargeBuffer<unsigned char> b(bytes);
     const auto at = reinterpret_cast<uintptr_t>(b.get());
     EXPECT_EQ(at % 64, 0u);
-    if (bytes >= kHugeArrayMinBytes) EXPECT_EQ(at % kHugePageBytes, 0u);
+    if (bytes >= kHugeArrayMinBytes) {
+      EXPECT_EQ(at % kHugePageBytes, 0u);
+    }
     for (size_t i = 0; i < bytes; ++i) b[i] = static_cast<unsigned char>(i * 7);
     size_t wrong = 0;
     for (size_t i = 0; i < bytes; ++i) wrong += b[i] != static_cast<unsigned char>(i * 7) ? 1 : 0;
