@@ -4,17 +4,11 @@
 # scenes of 100k to 5M triangles (bench/make-scene.sh) and the largest scenes of views.tsv. Three
 # runs per cell, the two accelerators interleaved; the table gives the medians and their ratio.
 # Writes docs/bench/build-scale.md and build-scale.tsv; about 6 minutes on 2 cores.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
-T=build/release/tracer
-O=docs/bench
+source "$(dirname "$0")/bench-prelude.sh"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 runs=${RUNS:-3}
 
-field() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 # measure NAME VIEWS: one row per thread count.

@@ -6,10 +6,7 @@
 # Then, for the shared scenes, instructions of one geometry load and of one tinyobjloader parse,
 # counted by valgrind (exact, where this VM's times move by tens of percent).
 # Writes docs/bench/load.md; about 5 minutes on 2 cores.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
+source "$(dirname "$0")/bench-prelude.sh"
 L=build/release/bench/tracer_load_time
 S=../shared/scenes
 out=docs/bench/load.md

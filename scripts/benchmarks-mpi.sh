@@ -4,14 +4,8 @@
 # four Cornell views and Sponza, for ao and for path; the render time, and rank 0's time spent
 # answering tile requests. Run from the project root with ../shared/scenes beside it, on an
 # otherwise idle machine; scripts/benchmarks.sh runs it too. Output: docs/bench/mpi.md.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
-T=build/release/tracer
+source "$(dirname "$0")/bench-prelude.sh"
 M=build/release/tracer-mpi
-O=docs/bench
-mkdir -p "$O"
 # --bind-to none: with two ranks or fewer Open MPI binds each rank to one core, which would make
 # "1 rank x 2 threads" share one core.
 MPIRUN=(mpirun --oversubscribe --bind-to none)
@@ -19,14 +13,13 @@ MPIRUN=(mpirun --oversubscribe --bind-to none)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-field() { grep -o "\"$1\": [0-9.e+-]*" "$2" | head -1 | awk '{print $2}'; }
 # The best (lowest) render_ms of three runs of a command that writes --stats-json to $work/s.json.
 best_of_three() {
   local best=""
   for _ in 1 2 3; do
     "$@" >/dev/null 2>&1
     local ms
-    ms=$(field render_ms "$work/s.json")
+    ms=$(field "$work/s.json" render_ms)
     if [[ -z $best ]] || awk "BEGIN{exit !($ms < $best)}"; then best=$ms; fi
   done
   echo "$best"
@@ -44,8 +37,8 @@ best_of_three() {
       one=$(best_of_three "$T" render "${flags[@]}" --threads 2)
       r1=$(best_of_three "${MPIRUN[@]}" -np 1 "$M" render "${flags[@]}" --threads 2)
       r2=$(best_of_three "${MPIRUN[@]}" -np 2 "$M" render "${flags[@]}" --threads 1)
-      requests=$(field rank0_messages "$work/s.json")
-      per=$(field rank0_us_per_message "$work/s.json")
+      requests=$(field "$work/s.json" rank0_messages)
+      per=$(field "$work/s.json" rank0_us_per_message)
       printf '| %s | %s | %.1f | %.1f | %.1f | %.2fx | %s | %.1f |\n' "$view" "$name" "$one" "$r1" "$r2" \
         "$(awk "BEGIN{print $r2 / $one}")" "$requests" "$per"
     done
@@ -62,8 +55,8 @@ best_of_three() {
   for tile in 8 16 32 64; do
     "${MPIRUN[@]}" -np 2 "$M" render --view sponza --integrator path --spp 16 --width 512 --height 512 --tile $tile \
       --threads 1 -q -o "$work/x.png" --stats-json "$work/s.json" >/dev/null 2>&1
-    printf '| %d | %s | %.1f | %.1f | %.1f |\n' "$tile" "$(field rank0_messages "$work/s.json")" \
-      "$(field rank0_us_per_message "$work/s.json")" "$(field rank0_message_ms "$work/s.json")" \
-      "$(field render_ms "$work/s.json")"
+    printf '| %d | %s | %.1f | %.1f | %.1f |\n' "$tile" "$(field "$work/s.json" rank0_messages)" \
+      "$(field "$work/s.json" rank0_us_per_message)" "$(field "$work/s.json" rank0_message_ms)" \
+      "$(field "$work/s.json" render_ms)"
   done
 } | tee -a "$O/mpi.md"

@@ -5,13 +5,7 @@
 # as RMSE against a 2048-spp reference, with NEE+MIS and with BSDF sampling alone.
 # Run from the project root with ../shared/scenes beside it, on an otherwise idle machine;
 # scripts/benchmarks.sh runs it too. Outputs go to docs/bench/.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
-T=build/release/tracer
-O=docs/bench
-mkdir -p "$O"
+source "$(dirname "$0")/bench-prelude.sh"
 
 for t in 1 2; do
   $T bench --integrator path --spp 16 --scenes all --variants bvh8,embree --size 512x512 --runs 3 --best 2 \

@@ -5,18 +5,11 @@
 # API, 2 threads, 1024x1024, 16 AO rays. Load is tracer's loader against tinyobjloader's own
 # parse of the file (bench/load_time.cpp). Peak memory is each process's peak resident set.
 # Writes docs/bench/scale.md, scale.tsv and scale.svg; about 5 minutes on 2 cores.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
-T=build/release/tracer
+source "$(dirname "$0")/bench-prelude.sh"
 L=build/release/bench/tracer_load_time
-O=docs/bench
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# A number from a --stats-json file (the files are pretty-printed: one key per line).
-field() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 
 # measure NAME VIEWS OBJ: one row of scale.tsv.
 measure() {
