@@ -216,7 +216,7 @@ void expect_parallel_builds_match(const Scene& scene) {
 }
 
 TEST(BuildDeterminism, ParallelBuildersMatchSequentialTree) {
-  expect_parallel_builds_match(make_cornell_box(40'000));  // large enough for the parallel top-level passes
+  expect_parallel_builds_match(make_cornell_box(100'000));  // past PrimSplitter::kParallelSplit at the top
 }
 
 TEST(BuildDeterminism, ParallelBuildersMatchOnSphereScene) {

@@ -130,10 +130,11 @@ class BvhBuilder {
     if (n.left == kInvalidIndex) {
       f.index = r.begin;
       f.count = r.size();
-      const PrimRef* refs = splitter_.refs(r);
-      for (uint32_t i = r.begin; i < r.end; ++i) {
-        out.ids[i] = refs[i].id();
-        if (out.leaf_of) out.leaf_of[refs[i].id()] = flat;
+      const PrimRef* refs = splitter_.refs();
+      for (uint32_t i = r.begin; i < r.end; ++i) out.ids[i] = refs[i].id();
+      std::sort(out.ids + r.begin, out.ids + r.end);  // the partitions' order is not the same on every executor
+      if (out.leaf_of) {
+        for (uint32_t i = r.begin; i < r.end; ++i) out.leaf_of[out.ids[i]] = flat;
       }
       return;
     }

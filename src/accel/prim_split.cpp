@@ -155,8 +155,8 @@ PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, c
   options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
   const auto n = static_cast<uint32_t>(scene.size());
   // Left uninitialised: every slot is written before it is read.
-  for (auto& b : buffers_) b = LargeBuffer<PrimRef>(n);
-  PrimRef* refs = buffers_[0].get();
+  refs_ = LargeBuffer<PrimRef>(n);
+  PrimRef* refs = refs_.get();
   // Degenerate triangles are left out. In parallel: count per block, then fill at the offsets.
   const auto fill = [&](uint32_t b, uint32_t e, uint32_t out) {
     for (uint32_t i = b; i < e; ++i) {
@@ -185,7 +185,7 @@ PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, c
 
 void PrimSplitter::bound(PrimRange& r, bool parallel) const {
   if (r.bounds_known) return;
-  const PrimRef* refs = buffers_[r.buffer].get();
+  const PrimRef* refs = refs_.get();
   const auto body = [&](uint32_t from, uint32_t to, Bounds4 acc) {
     for (uint32_t i = from; i < to; ++i) acc.add(refs[i]);
     return acc;
@@ -201,8 +201,7 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
   if (is_cancelled(options_.cancel)) return false;  // the builder then throws Cancelled
   bound(node, parallel);
   const uint32_t begin = node.begin, end = node.end, count = end - begin;
-  PrimRef* refs = buffers_[node.buffer].get();
-  uint8_t child_buffer = node.buffer;  // partitions move the halves to the other buffer
+  PrimRef* refs = refs_.get();
   uint32_t mid;
   bool halves_known = false;
   if (options_.split == BvhSplit::Median) {
@@ -224,10 +223,9 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
         const float leaf_cost = options_.intersection_cost * float(count);
         if (count <= uint32_t(options_.max_leaf) && leaf_cost <= sah.cost) return false;
         const Binner binner(node.cbox, sah.bins);
-        child_buffer = uint8_t(1 - node.buffer);
         SideCentroids centroids;
         mid = begin + sah.left_count;
-        partition(refs, buffers_[child_buffer].get(), begin, end, mid, parallel, centroids,
+        partition(refs, begin, end, mid, parallel, centroids,
                   [&](const PrimRef& prim) { return binner(prim.center(sah.axis), sah.axis) < sah.split_bin; });
         out[0].box = sah.left_box;
         out[1].box = sah.right_box;
@@ -242,7 +240,6 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
     h.begin = c == 0 ? begin : mid;
     h.end = c == 0 ? mid : end;
     h.depth = node.depth + 1;
-    h.buffer = child_buffer;
     h.bounds_known = halves_known;
     bound(h, parallel && h.size() >= kParallelSplit);
   }
@@ -344,43 +341,77 @@ PrimSplitter::SahChoice PrimSplitter::sah_split(const PrimRef* refs, const PrimR
   return best;
 }
 
-// Stable partition of src[begin, end) into dst[begin, end) by `pred`, whose true count the
-// binning already gave (`mid` = begin + that count), gathering each side's centroid bounds on
-// the way (the boxes come from the bins) so the children need no bounds pass of their own.
-// Each primitive is stored once at a selected index: the side decides no branch, which the
-// CPU could not predict. The parallel path computes the same permutation and bounds.
+// Partition of refs[begin, end) in place by `pred`, whose true count the binning already gave
+// (`mid` = begin + that count), gathering each side's centroid bounds on the way (the boxes come
+// from the bins) so the halves need no bounds pass of their own. The order within each half
+// depends on the path taken (sequential, or blocks in parallel); which primitives go to each half
+// does not, and every later decision depends only on that set (the leaves are ordered by
+// triangle at the end), so every executor still builds the same tree.
 template <class Pred>
-void PrimSplitter::partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid,
-                             bool parallel, SideCentroids& out, const Pred& pred) {
-  const auto run = [&](uint32_t b, uint32_t e, uint32_t l, uint32_t r, SideCentroids& acc) {
+void PrimSplitter::partition(PrimRef* refs, uint32_t begin, uint32_t end, uint32_t mid, bool parallel,
+                             SideCentroids& out, const Pred& pred) {
+  // Lomuto's partition without a branch on the side, which the CPU could not predict: each
+  // primitive is swapped with the first right one, and the boundary moves past it if it is left.
+  const auto run = [&](uint32_t b, uint32_t e, SideCentroids& acc) {
+    uint32_t k = b;
     for (uint32_t i = b; i < e; ++i) {
-      const PrimRef& p = src[i];
+      const PrimRef p = refs[i];
       const bool left = pred(p);
-      dst[left ? l : r] = p;
-      l += uint32_t(left);
-      r += uint32_t(!left);
+      refs[i] = refs[k];
+      refs[k] = p;
+      k += uint32_t(left);
       acc.add(left, p);
     }
+    return k - b;
   };
   if (!parallel) {
-    run(begin, end, begin, mid, out);
+    run(begin, end, out);
     return;
   }
+  // In parallel: each block partitioned in place, then the right primitives left of `mid` and the
+  // left ones right of it (as many of each) swapped pairwise, in chunks of ranks.
   const uint32_t blocks = (end - begin + kPartitionBlock - 1) / kPartitionBlock;
-  std::vector<uint32_t> left_counts(blocks + 1, 0);
-  exec_.for_each(blocks, [&](size_t k) {
-    const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
-    uint32_t c = 0;
-    for (uint32_t i = b; i < e; ++i) c += pred(src[i]) ? 1 : 0;
-    left_counts[k + 1] = c;
-  });
-  for (uint32_t k = 0; k < blocks; ++k) left_counts[k + 1] += left_counts[k];
+  std::vector<uint32_t> left_count(blocks);
   std::vector<SideCentroids> block(blocks);
   exec_.for_each(blocks, [&](size_t k) {
-    const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock);
-    run(b, e, begin + left_counts[k], mid + (b - begin) - left_counts[k], block[k]);  // rights before this block
+    const uint32_t b = begin + uint32_t(k) * kPartitionBlock;
+    left_count[k] = run(b, std::min(end, b + kPartitionBlock), block[k]);
   });
   for (uint32_t k = 0; k < blocks; ++k) out.join(block[k]);
+  // The misplaced runs, in position order: rights in [begin, mid), lefts in [mid, end).
+  struct Run {
+    uint32_t first, size;
+  };
+  std::vector<Run> rights, lefts;
+  for (uint32_t k = 0; k < blocks; ++k) {
+    const uint32_t b = begin + k * kPartitionBlock, e = std::min(end, b + kPartitionBlock), m = b + left_count[k];
+    if (std::min(e, mid) > std::max(m, begin)) rights.push_back({m, std::min(e, mid) - m});
+    if (m > std::max(b, mid)) lefts.push_back({std::max(b, mid), m - std::max(b, mid)});
+  }
+  // Rank of each run's first element; both lists hold the same number of primitives.
+  const auto ranks = [](const std::vector<Run>& runs) {
+    std::vector<uint64_t> r(runs.size() + 1, 0);
+    for (size_t i = 0; i < runs.size(); ++i) r[i + 1] = r[i] + runs[i].size;
+    return r;
+  };
+  const std::vector<uint64_t> rank_r = ranks(rights), rank_l = ranks(lefts);
+  const uint64_t misplaced = rank_r.back();
+  const auto chunks = uint32_t((misplaced + kPartitionBlock - 1) / kPartitionBlock);
+  exec_.for_each(chunks, [&](size_t c) {
+    const uint64_t from = uint64_t(c) * kPartitionBlock, to = std::min(misplaced, from + kPartitionBlock);
+    // The run holding rank `from`, and the offset in it, in each list.
+    const auto locate = [from](const std::vector<uint64_t>& r) {
+      const size_t i = size_t(std::upper_bound(r.begin(), r.end(), from) - r.begin()) - 1;
+      return std::pair<size_t, uint32_t>(i, uint32_t(from - r[i]));
+    };
+    auto [ri, ro] = locate(rank_r);
+    auto [li, lo] = locate(rank_l);
+    for (uint64_t n = from; n < to; ++n) {
+      std::swap(refs[rights[ri].first + ro], refs[lefts[li].first + lo]);
+      if (++ro == rights[ri].size) ++ri, ro = 0;
+      if (++lo == lefts[li].size) ++li, lo = 0;
+    }
+  });
 }
 
 }  // namespace tracer

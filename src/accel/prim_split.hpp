@@ -3,8 +3,10 @@
 // The binary BVH's builder and the 8-wide BVH's direct builder both split with this one class, so
 // a range gets the same two halves in either tree.
 //
-// Determinism: a split is a pure function of the range's primitives, and partitions are stable,
-// so every executor (sequential, forked, data-parallel) gives the same halves in the same order.
+// Determinism: a split is a pure function of the set of primitives in the range (bounds, bins and
+// the median are the same in any order), so every executor (sequential, forked, data-parallel)
+// gives the same halves; only their order inside a range may differ, which the builders remove
+// by ordering each leaf's triangles.
 #pragma once
 
 #include <bit>
@@ -43,14 +45,13 @@ struct alignas(32) PrimRef {
 };
 static_assert(sizeof(PrimRef) == 32);
 
-// A run [begin, end) of primitives in one of the splitter's two buffers, with its bounds once
+// A run [begin, end) of the splitter's primitives, with its bounds once
 // known (a split computes its halves' bounds on the way, so most ranges never need a pass).
 struct PrimRange {
   Aabb box;   // of the primitives' boxes
   Aabb cbox;  // of their centroids
   uint32_t begin = 0, end = 0;
   uint32_t depth = 0;         // splits from the root: past kMedianFallbackDepth, halve by count
-  uint8_t buffer = 0;         // which buffer holds [begin, end)
   bool bounds_known = false;  // box and cbox valid
   uint32_t size() const { return end - begin; }
 };
@@ -65,8 +66,9 @@ class PrimSplitter {
   PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 
   uint32_t count() const { return count_; }
-  PrimRange root() const { return PrimRange{{}, {}, 0, count_, 0, 0, false}; }
-  const PrimRef* refs(const PrimRange& r) const { return buffers_[r.buffer].get(); }
+  PrimRange root() const { return PrimRange{{}, {}, 0, count_, 0, false}; }
+  // The primitives; a range's are refs()[begin, end), in no particular order.
+  const PrimRef* refs() const { return refs_.get(); }
 
   // Computes r's bounds if not yet known.
   void bound(PrimRange& r, bool parallel) const;
@@ -81,14 +83,12 @@ class PrimSplitter {
   SahChoice sah_split(const PrimRef* refs, const PrimRange& r, bool parallel) const;
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
   template <class Pred>
-  void partition(const PrimRef* src, PrimRef* dst, uint32_t begin, uint32_t end, uint32_t mid, bool parallel,
-                 SideCentroids& out, const Pred& pred);
+  void partition(PrimRef* refs, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, SideCentroids& out,
+                 const Pred& pred);
 
   BvhBuildOptions options_;
   const Executor& exec_;
-  // Two buffers of count_ primitives: a partition reads a range from one and writes its halves
-  // into the other (no copy back); PrimRange::buffer says which holds a range.
-  LargeBuffer<PrimRef> buffers_[2];
+  LargeBuffer<PrimRef> refs_;  // count_ primitives, each range's partitioned in place
   uint32_t count_ = 0;
 };
 

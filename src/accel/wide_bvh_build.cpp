@@ -100,9 +100,8 @@ class WideBuilder {
       w.count[i] = 0;
       if (!used) continue;
       if (packable(kids[i])) {
-        // A leaf, in scratch: its first primitive and, above the count, which buffer holds it.
-        w.child[i] = kids[i].begin;
-        w.count[i] = kids[i].size() | uint32_t(kids[i].buffer) << 8;
+        w.child[i] = kids[i].begin;  // in scratch, a leaf's first primitive
+        w.count[i] = kids[i].size();
       } else {
         w.child[i] = used_.fetch_add(1, std::memory_order_relaxed);
         inner[inner_count] = kids[i];
@@ -153,8 +152,7 @@ class WideBuilder {
         out[self].child[i] = 0;
       } else if (count != 0) {
         out[self].child[i] = static_cast<uint32_t>(runs_.size());
-        out[self].count[i] = count & 0xff;
-        runs_.push_back({child, count & 0xff, uint8_t(count >> 8)});
+        runs_.push_back({child, count});
       } else {
         const uint32_t placed = place(child, out);  // may reallocate out: index, not reference
         out[self].child[i] = placed;
@@ -170,9 +168,12 @@ class WideBuilder {
     const auto fill = [&](size_t begin, size_t end) {
       for (size_t k = begin; k < end; ++k) {
         const Run& r = runs_[k];
-        const PrimRef* refs = splitter_.refs(PrimRange{{}, {}, 0, 0, 0, r.buffer, false});
         uint32_t ids[kWideWidth];
-        for (uint32_t j = 0; j < r.count; ++j) ids[j] = refs[r.first + j].id();
+        for (uint32_t j = 0; j < r.count; ++j) ids[j] = splitter_.refs()[r.first + j].id();
+        // By triangle: the partitions' order is not the same on every executor. At most eight.
+        for (uint32_t j = 1; j < r.count; ++j) {
+          for (uint32_t m = j; m > 0 && ids[m - 1] > ids[m]; --m) std::swap(ids[m - 1], ids[m]);
+        }
         packs[k] = make_triangle_pack(scene_.triangles, ids, 0, r.count);
       }
     };
@@ -183,7 +184,6 @@ class WideBuilder {
 
   struct Run {
     uint32_t first, count;
-    uint8_t buffer;
   };
 
   const Scene& scene_;
