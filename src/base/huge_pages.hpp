@@ -14,7 +14,7 @@
 namespace tracer {
 
 inline constexpr size_t kHugePageBytes = size_t(2) << 20;
-// From this size an array gets its own 2 MiB-aligned mapping.
+// From this size an array is 2 MiB-aligned and advised to live on huge pages.
 inline constexpr size_t kHugeArrayMinBytes = size_t(1) << 20;
 
 // At least `bytes`, 64-byte aligned; 2 MiB-aligned and huge-page advised from kHugeArrayMinBytes.
