@@ -10,7 +10,7 @@ namespace tracer {
 // twice, or a benchmark that keeps freed memory, does not fault them in again); aligned to 2 MiB
 // and advised, because THP only backs aligned 2 MiB ranges.
 void* allocate_large(size_t bytes) {
-  if (bytes < kHugeArrayMinBytes) return ::operator new(bytes == 0 ? 1 : bytes, std::align_val_t{64});
+  if (bytes < kHugeArrayMinBytes) return ::operator new (bytes == 0 ? 1 : bytes, std::align_val_t{64});
   const size_t len = (bytes + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
   void* p = std::aligned_alloc(kHugePageBytes, len);
   if (!p) throw std::bad_alloc();
@@ -20,7 +20,7 @@ void* allocate_large(size_t bytes) {
 
 void free_large(void* p, size_t bytes) noexcept {
   if (!p) return;
-  if (bytes < kHugeArrayMinBytes) return ::operator delete(p, std::align_val_t{64});
+  if (bytes < kHugeArrayMinBytes) return ::operator delete (p, std::align_val_t{64});
   std::free(p);
 }
 
