@@ -48,19 +48,18 @@ class BvhBuilder {
   // Depth-first flattening into the final layout, children adjacent; `ids` receives the scene
   // triangle index of every leaf slot. Each subtree's place follows from its size alone, so the
   // tasks build flattens its large subtrees in parallel into the same layout.
-  // `pair_parent` (if not null) receives each sibling pair's parent, `leaf_of` (if not null,
-  // sized to the scene) each scene triangle's leaf.
-  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>* pair_parent,
-               std::vector<uint32_t>* leaf_of) {
+  // `pair_parent` receives each sibling pair's parent, `leaf_of` (sized to the scene) each scene
+  // triangle's leaf.
+  void flatten(BvhNodeArray& out, std::vector<uint32_t>& ids, std::vector<uint32_t>& pair_parent,
+               std::vector<uint32_t>& leaf_of) {
     const uint32_t count = splitter_.count();
     ids.resize(count);
     // subtree_size() also fills in the sizes the queue build left unknown at the top.
     out.resize(count == 0 ? 0 : subtree_size(0) + 1);  // + the padding node
-    if (pair_parent) pair_parent->assign((out.size() + 1) / 2, 0);
+    pair_parent.assign((out.size() + 1) / 2, 0);
     if (count == 0) return;
     out[1] = BvhNode{{}, 0, {}, 0};  // padding: children pairs start at even indices
-    const Output o{out.data(), ids.data(), pair_parent ? pair_parent->data() : nullptr,
-                   leaf_of ? leaf_of->data() : nullptr};
+    const Output o{out.data(), ids.data(), pair_parent.data(), leaf_of.data()};
     place(o, 0, 0, 2, exec_.data_parallel());
   }
 
@@ -133,14 +132,12 @@ class BvhBuilder {
       const PrimRef* refs = splitter_.refs();
       for (uint32_t i = r.begin; i < r.end; ++i) out.ids[i] = refs[i].id();
       std::sort(out.ids + r.begin, out.ids + r.end);  // the partitions' order is not the same on every executor
-      if (out.leaf_of) {
-        for (uint32_t i = r.begin; i < r.end; ++i) out.leaf_of[out.ids[i]] = flat;
-      }
+      for (uint32_t i = r.begin; i < r.end; ++i) out.leaf_of[out.ids[i]] = flat;
       return;
     }
     f.index = next;
     f.count = 0;
-    if (out.pair_parent) out.pair_parent[next / 2] = flat;
+    out.pair_parent[next / 2] = flat;
     const uint32_t left = n.left, right_next = next + 2 + (nodes_[left].subtree - 1);
     const auto place_left = [&] { place(out, left, next, next + 2, parallel); };
     const auto place_right = [&] { place(out, left + 1, next + 1, right_next, parallel); };
@@ -199,7 +196,7 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exe
     BvhBuilder builder(scene, options, exec);
     builder.build();
     leaf_of_.assign(scene.size(), kInvalidIndex);
-    builder.flatten(nodes_, ids_, &pair_parent_, &leaf_of_);
+    builder.flatten(nodes_, ids_, pair_parent_, leaf_of_);
     tris_.resize(ids_.size());
     const auto copy = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) tris_[i] = scene.triangles[ids_[i]];

@@ -29,9 +29,8 @@ class WideBuilder {
       : scene_(scene), options_(options), exec_(exec), splitter_(scene, options, exec) {
     // Every inner node holds more than one pack's primitives and at least two children, and one
     // with fewer than eight has only packs below it, so n primitives make fewer than n/2 + 2.
-    capacity_ = splitter_.count() / 2 + 2;
     // Left uninitialised: only the nodes taken are touched.
-    scratch_ = LargeBuffer<WideNode>(capacity_);
+    scratch_ = LargeBuffer<WideNode>(splitter_.count() / 2 + 2);
   }
 
   // Builds the tree into `nodes` and `packs`; returns the bounds of everything in it.
@@ -51,6 +50,8 @@ class WideBuilder {
   }
 
  private:
+  // A subtree of at most one pack's worth of triangles becomes one leaf: testing eight lanes
+  // costs about what one more level of boxes would, and saves that level's loads.
   static bool packable(const PrimRange& r) { return r.size() <= uint32_t(kWideWidth); }
   bool parallel_split(const PrimRange& r) const {
     return exec_.data_parallel() && r.size() >= PrimSplitter::kParallelSplit;
@@ -190,7 +191,6 @@ class WideBuilder {
   const BvhBuildOptions& options_;
   const Executor& exec_;
   PrimSplitter splitter_;
-  size_t capacity_ = 0;
   LargeBuffer<WideNode> scratch_;
   std::atomic<uint32_t> used_{0};
   std::atomic<bool> failed_{false};
