@@ -45,8 +45,8 @@ struct alignas(32) PrimRef {
 };
 static_assert(sizeof(PrimRef) == 32);
 
-// A run [begin, end) of the splitter's primitives, with its bounds once
-// known (a split computes its halves' bounds on the way, so most ranges never need a pass).
+// A run [begin, end) of the splitter's primitives, with its bounds once known (a split computes
+// its halves' bounds on the way, so most ranges never need a pass).
 struct PrimRange {
   Aabb box;   // of the primitives' boxes
   Aabb cbox;  // of their centroids

@@ -8,8 +8,6 @@
 // whatever order threads reach them, are copied depth-first into their final places.
 #include <algorithm>
 #include <atomic>
-#include <cstdlib>
-#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -37,7 +35,7 @@ class WideBuilder {
   Aabb build(WideNodeArray& nodes, PackArray& packs) {
     if (splitter_.count() == 0) return Aabb{};
     PrimRange root = splitter_.root();
-    splitter_.bound(root, exec_.data_parallel() && root.size() >= PrimSplitter::kParallelSplit);
+    splitter_.bound(root, parallel_split(root));
     used_ = 1;
     build_node(root, 0);
     throw_if_cancelled(options_.cancel);

@@ -1,8 +1,8 @@
 // Large arrays on transparent huge pages. On a Linux kernel whose THP mode is `madvise` (Debian's
-// default), an anonymous mapping asks for 2 MiB pages with madvise(MADV_HUGEPAGE): the first touch
+// default), memory asks for 2 MiB pages with madvise(MADV_HUGEPAGE): the first touch
 // of each 2 MiB then costs one page fault instead of 512, and the TLB holds 512 times the reach.
 // In a VM a fault costs 7-16 us, which at millions of triangles is seconds of a build (Embree's
-// allocator asks for huge pages the same way). Small arrays stay on the heap.
+// allocator asks for huge pages the same way). Small arrays are plain 64-byte aligned blocks.
 #pragma once
 
 #include <cstddef>
