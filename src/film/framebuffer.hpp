@@ -47,6 +47,16 @@ class Framebuffer {
   uint32_t min_samples() const;
   // Most samples of any pixel: 0 while no pixel has one.
   uint32_t max_samples() const;
+  // Makes the pixels of `tile` (in this image's coordinates) hold what `from`'s hold: a copy of a
+  // render in progress, taken tile by tile as tiles finish (the viewer's display image).
+  void copy_tile(const Framebuffer& from, const Tile& tile) {
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        sum_[index(x, y)] = from.sum_[from.index(x, y)];
+        samples_[index(x, y)] = from.samples_[from.index(x, y)];
+      }
+    }
+  }
   // Raw sums by pixel index (row-major), for sending a window's pixels to another rank.
   const Vec3* sums() const { return sum_.data(); }
 

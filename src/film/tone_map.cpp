@@ -33,6 +33,18 @@ Image8 tonemap(const Framebuffer& fb, float exposure) {
   return img;
 }
 
+void tonemap_tile(const Framebuffer& fb, float exposure, const Tile& tile, Image8& image) {
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    size_t k = (size_t(y) * size_t(image.width) + size_t(tile.x0)) * 3;
+    for (int x = tile.x0; x < tile.x1; ++x) {
+      const Vec3 c = fb.radiance(x, y);
+      image.rgb[k++] = encode(c.x, exposure);
+      image.rgb[k++] = encode(c.y, exposure);
+      image.rgb[k++] = encode(c.z, exposure);
+    }
+  }
+}
+
 bool looks_black(const Framebuffer& fb, float exposure) {
   for (int y = 0; y < fb.height(); ++y) {
     for (int x = 0; x < fb.width(); ++x) {

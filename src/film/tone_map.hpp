@@ -18,6 +18,9 @@ struct Image8 {
 // curve, rounded to 8 bits.
 Image8 tonemap(const Framebuffer& fb, float exposure);
 
+// Tone-maps the pixels of `tile` into `image` (of fb's size), as tonemap() maps them.
+void tonemap_tile(const Framebuffer& fb, float exposure, const Tile& tile, Image8& image);
+
 // Whether tonemap(fb, exposure) is black in every pixel: a render a user must be told about.
 bool looks_black(const Framebuffer& fb, float exposure);
 

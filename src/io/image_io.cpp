@@ -163,14 +163,34 @@ void write_image(const std::string& path, const Image8& image) {
     bytes = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
     bytes.append(reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
   } else {
-    const auto sink = [](void* ctx, void* data, int size) {
-      static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size));
-    };
-    if (!stbi_write_png_to_func(sink, &bytes, image.width, image.height, 3, image.rgb.data(), image.width * 3)) {
-      throw InputError(path + ": PNG encoding failed");
-    }
+    bytes = encode_png(image);
   }
   write_file_atomic(path, bytes);
+}
+
+namespace {
+
+void append_to_string(void* ctx, void* data, int size) {
+  static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size));
+}
+
+}  // namespace
+
+std::string encode_png(const Image8& image) {
+  std::string bytes;
+  if (!stbi_write_png_to_func(append_to_string, &bytes, image.width, image.height, 3, image.rgb.data(),
+                              image.width * 3)) {
+    throw InputError("PNG encoding failed");
+  }
+  return bytes;
+}
+
+std::string encode_jpeg(const Image8& image, int quality) {
+  std::string bytes;
+  if (!stbi_write_jpg_to_func(append_to_string, &bytes, image.width, image.height, 3, image.rgb.data(), quality)) {
+    throw InputError("JPEG encoding failed");
+  }
+  return bytes;
 }
 
 void remove_pending_temp_file() {

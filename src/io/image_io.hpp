@@ -15,6 +15,11 @@ enum class ImageFormat { Png, Ppm, Exr };
 // From the path's extension (.png, .ppm or .exr, any case); throws UsageError naming `flag` otherwise.
 ImageFormat image_format_for(const std::string& path, const std::string& flag = "-o");
 
+// The bytes of a PNG file of `image` (what write_image writes); of a baseline JPEG of it at
+// `quality` 1-100 (the viewer's frames: a fifth of the PNG's bytes, encoded several times faster).
+std::string encode_png(const Image8& image);
+std::string encode_jpeg(const Image8& image, int quality);
+
 // Encodes and writes; throws InputError("PATH: cannot write: reason") on failure.
 void write_image(const std::string& path, const Image8& image);
 
