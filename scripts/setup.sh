@@ -11,8 +11,12 @@ PACKAGES=(
   libtinyobjloader-dev libfast-float-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
   libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
-  libopenmpi-dev openmpi-bin
+  libopenmpi-dev openmpi-bin libcpp-httplib-dev
+  chromium  # tracer view's browser test (headless)
 )
+# Node.js and npm for the browser test's playwright-core: Debian's, unless a node with npm is
+# already installed (NodeSource's nodejs bundles npm and conflicts with Debian's npm package).
+command -v npm >/dev/null || PACKAGES+=(nodejs npm)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

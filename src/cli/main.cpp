@@ -1,4 +1,5 @@
-// tracer: the command-line front end. Exit codes: 0 ok, 1 bad input, 2 bad usage, 130 interrupted.
+// tracer: the command-line front end (render, view, info, bench, compare). Exit codes: 0 ok, 1 bad input, 2 bad usage,
+// 130 interrupted.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,7 @@
 #include "driver/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
+#include "view/view_command.hpp"
 
 namespace tracer::cli {
 
@@ -160,6 +162,15 @@ int main(int argc, char** argv) {
   compare->add_option("a", compare_a, "an image (e.g. the reference)")->required();
   compare->add_option("b", compare_b, "an image of the same size and kind")->required();
 
+  view::ViewArgs view_args;
+  CLI::App* view_cmd = app.add_subcommand(
+      "view", "look around a scene in the browser while it renders (prints a URL; every render flag works)");
+  add_render_options(*view_cmd, view_args.render);
+  view_cmd->add_option("--listen", view_args.listen, "address to serve on (the default keeps it to this machine)")
+      ->capture_default_str();
+  view_cmd->add_option("--port", view_args.port, "port to serve on, 0 for any free one")->capture_default_str();
+  view_cmd->add_flag("-q,--quiet", view_args.render.quiet, "no loader warnings");
+
   BenchArgs bench_args;
   CLI::App* bench = app.add_subcommand("bench", "time the study's variants and ours on the Cornell scenes and more");
   add_bench_options(*bench, bench_args);
@@ -169,7 +180,7 @@ int main(int argc, char** argv) {
     try {
       app.get_subcommand(argv[1]);
     } catch (const CLI::OptionNotFound&) {
-      std::cerr << "tracer: error: unknown command '" << argv[1] << "' (render, info, bench, compare)\n";
+      std::cerr << "tracer: error: unknown command '" << argv[1] << "' (render, view, info, bench, compare)\n";
       return 2;
     }
   }
@@ -182,6 +193,12 @@ int main(int argc, char** argv) {
   }
   try {
     if (render->parsed()) return cmd_render(render_args);
+    if (view_cmd->parsed()) {
+      view_args.width_given = view_cmd->count("--width") > 0;
+      view_args.height_given = view_cmd->count("--height") > 0;
+      view_args.user_flags.assign(argv + 2, argv + argc);
+      return view::run_view(std::move(view_args));
+    }
     if (info->parsed()) return cmd_info(info_args);
     if (bench->parsed()) return run_bench(bench_args);
     if (compare->parsed()) return cmd_compare(compare_a, compare_b);

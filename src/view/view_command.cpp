@@ -1,0 +1,75 @@
+#include "view/view_command.hpp"
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <future>
+#include <iostream>
+#include <thread>
+
+#include "base/errors.hpp"
+#include "driver/parse.hpp"
+#include "driver/signals.hpp"
+#include "parallel/thread_count.hpp"
+#include "view/view_server.hpp"
+#include "view/view_session.hpp"
+
+namespace tracer::view {
+
+int run_view(ViewArgs args) {
+  using namespace driver;
+  install_stop_handlers();
+  std::signal(SIGPIPE, SIG_IGN);  // a closed tab is a failed write, not the end of the process
+  const CancelFlag cancel = &stop_requested();
+  RenderArgs& r = args.render;
+  if (!args.width_given) r.settings.width = kDefaultViewSide;
+  if (!args.height_given) r.settings.height = kDefaultViewSide;
+  check_range("--port", args.port, 0, 65535);
+  // The render flags that make files or sequences mean nothing here (save downloads the image).
+  if (r.frames != 1) throw UsageError("--frames: not for tracer view (an image sequence is tracer render's)");
+  if (r.orbit != 0.0) throw UsageError("--orbit: not for tracer view (drag to orbit)");
+  if (r.checkpoint) throw UsageError("--checkpoint: not for tracer view (save downloads the image)");
+  check_range("--width", r.settings.width, 1, kMaxViewSide);
+  check_range("--height", r.settings.height, 1, kMaxViewSide);
+  validate(r);
+  WideBvh::force_simd_target(simd_target_for(r));
+  const ThreadLimit thread_limit(r.threads.value_or(0));
+
+  const Scene scene = load_scene(r.scene, r.quiet, cancel);
+  std::string note;
+  settings_for(r, scene, note);
+  if (!note.empty() && !r.quiet) std::cerr << "tracer: note: " << note << "\n";
+  AccelOptions accel_options = accel_options_for(r);
+  accel_options.bvh.cancel = cancel;
+  const Accelerator accel = build_accelerator(scene, accel_options);
+
+  ViewSession session(scene, accel, r, args.user_flags, kViewerFlags);
+  ViewServer server(session, random_token());
+  const int port = server.bind(args.listen, args.port);
+  session.start();
+  auto listening = std::async(std::launch::async, [&] { server.listen(); });
+  const std::string host = args.listen.find(':') != std::string::npos ? "[" + args.listen + "]" : args.listen;
+  std::printf("tracer: viewing %s at http://%s:%d/?token=%s (Ctrl-C stops)\n", scene.source.c_str(), host.c_str(), port,
+              server.token().c_str());
+  std::fflush(stdout);
+
+  while (!is_cancelled(cancel)) {
+    if (listening.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready) {
+      listening.get();  // the server ended by itself: say why
+      throw InputError("the HTTP server stopped unexpectedly");
+    }
+  }
+  session.stop();  // the pass in progress stops within a piece of a tile
+  server.stop();
+  // Idle keep-alive connections of a browser may hold the server's threads for up to a second;
+  // nothing is left to write, so the process does not wait for them.
+  if (listening.wait_for(std::chrono::milliseconds(300)) != std::future_status::ready) {
+    std::cerr << "tracer: " << stop_signal_name() << "\n";
+    std::fflush(stderr);
+    std::_Exit(exit_code_for_stop());
+  }
+  std::cerr << "tracer: " << stop_signal_name() << "\n";
+  return exit_code_for_stop();
+}
+
+}  // namespace tracer::view

@@ -1,0 +1,56 @@
+// The viewer's HTTP server (cpp-httplib): the page, the state, changes to it, the frames as
+// server-sent events, and the current image as PNG or EXR downloads. Every request must carry the
+// session's token (?token=...), so a page from another site cannot drive it.
+//
+//   GET  /             the page (HTML and script, served from the binary)
+//   GET  /state        the view state as JSON
+//   POST /control      a JSON object of fields to change (application/json, at most 4 KiB);
+//                      the new state, or 400 with {"error": "..."}
+//   GET  /events       text/event-stream: "frame" events, each a JSON object of the frame's facts
+//                      and its image (base64), always the newest one
+//   GET  /image.png    the accumulated image, tone-mapped; /image.exr its radiance
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "view/view_session.hpp"
+
+namespace httplib {
+class Server;
+}
+
+namespace tracer::view {
+
+// Frames and at most this many event streams at once (each holds a server thread).
+inline constexpr int kMaxEventStreams = 16;
+inline constexpr size_t kMaxControlBytes = 4096;
+
+// A token of 128 random bits, as 32 hex digits.
+std::string random_token();
+
+class ViewServer {
+ public:
+  ViewServer(ViewSession& session, std::string token);
+  ~ViewServer();
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+
+  // Binds host:port (port 0: any free port); returns the port. Throws UsageError if it cannot.
+  int bind(const std::string& host, int port);
+  // Serves until stop(); call after bind().
+  void listen();
+  // Ends every event stream and the listening; listen() returns.
+  void stop();
+  const std::string& token() const { return token_; }
+
+ private:
+  void add_routes();
+  ViewSession& session_;
+  const std::string token_;
+  std::unique_ptr<httplib::Server> server_;
+  std::atomic<int> streams_{0};
+};
+
+}  // namespace tracer::view

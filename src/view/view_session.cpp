@@ -1,0 +1,389 @@
+#include "view/view_session.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "base/errors.hpp"
+#include "io/image_io.hpp"
+#include "render/render_image.hpp"
+
+namespace tracer::view {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A preview is sized to render within this; the full image follows it.
+constexpr double kPreviewBudgetMs = 40.0;
+// Frames of a pass in progress (tiles refined so far) come at most this often.
+constexpr auto kProgressInterval = std::chrono::milliseconds(200);
+constexpr int kJpegQuality = 88;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string format_float(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return text;
+}
+
+// x,y,z of floats, each written so it parses back to the same float.
+std::string vec_text(Vec3 v) { return format_float(v.x) + "," + format_float(v.y) + "," + format_float(v.z); }
+
+nlohmann::json vec_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+double number_field(const std::string& key, const nlohmann::json& value, double lo, double hi) {
+  if (!value.is_number()) throw UsageError(key + ": expected a number, got " + value.dump());
+  const double v = value.get<double>();
+  if (!(v >= lo && v <= hi))
+    throw UsageError(key + ": " + value.dump() + " is outside [" + format_float(lo) + ", " + format_float(hi) + "]");
+  return v;
+}
+
+int int_field(const std::string& key, const nlohmann::json& value, int lo, int hi) {
+  const double v = number_field(key, value, lo, hi);
+  if (v != std::floor(v)) throw UsageError(key + ": expected a whole number, got " + value.dump());
+  return int(v);
+}
+
+Vec3 vec_field(const std::string& key, const nlohmann::json& value) {
+  if (!value.is_array() || value.size() != 3) throw UsageError(key + ": expected [x, y, z], got " + value.dump());
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = float(number_field(key, value[size_t(i)], -1e12, 1e12));
+  return v;
+}
+
+bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
+
+}  // namespace
+
+std::string shell_quote(const std::string& word) {
+  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_./,=:+-@%").find(c) != std::string::npos;
+  });
+  if (plain) return word;
+  std::string out = "'";
+  for (const char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string render_command(const driver::RenderArgs& a, const std::vector<std::string>& user_flags,
+                           const std::vector<std::string>& viewer_flags) {
+  std::vector<std::string> dropped(std::begin(kStateFlags), std::end(kStateFlags));
+  dropped.insert(dropped.end(), viewer_flags.begin(), viewer_flags.end());
+  std::string out = "tracer render";
+  for (size_t i = 0; i < user_flags.size(); ++i) {
+    const std::string& t = user_flags[i];
+    bool drop = false;
+    for (const std::string& flag : dropped) {
+      if (t == flag) {
+        drop = true;
+        ++i;  // and its value
+        break;
+      }
+      const bool is_short = flag.size() == 2;  // -v1,2,3 as well as -v=1,2,3
+      if (starts_with(t, flag + "=") || (is_short && starts_with(t, flag) && t.size() > 2)) {
+        drop = true;
+        break;
+      }
+    }
+    if (!drop) out += " " + shell_quote(t);
+  }
+  out += " --eye " + a.eye + " --look " + a.look + " --up " + a.up + " --fov " + format_float(*a.fov);
+  out += " --width " + std::to_string(a.settings.width) + " --height " + std::to_string(a.settings.height);
+  out += " --integrator " + a.integrator + " --spp " + std::to_string(*a.spp);
+  out += " --max-depth " + std::to_string(a.settings.max_depth) + " --exposure " + format_float(a.settings.exposure);
+  return out;
+}
+
+ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args,
+                         std::vector<std::string> user_flags, std::vector<std::string> viewer_flags)
+    : scene_(scene),
+      accel_(accel),
+      sched_(driver::sched_options_for(args)),
+      user_flags_(std::move(user_flags)),
+      viewer_flags_(std::move(viewer_flags)),
+      args_(args) {
+  // Every state flag explicit, so the copied command says exactly what is shown.
+  const CameraSpec camera = driver::camera_for(scene_, args_);
+  args_.eye = vec_text(camera.eye);
+  args_.look = vec_text(camera.look);
+  args_.up = vec_text(camera.up);
+  args_.fov = double(camera.fov_degrees);
+  std::string note;
+  const RenderSettings settings = driver::settings_for(args_, scene_, note);
+  args_.spp = settings.spp;
+  job_ = {generation_, driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note)};
+  exposure_ = settings.exposure;
+}
+
+ViewSession::~ViewSession() { stop(); }
+
+void ViewSession::start() {
+  thread_ = std::thread([this] { render_loop(); });
+}
+
+void ViewSession::stop() {
+  {
+    const std::lock_guard lock(mu_);
+    stopping_ = true;
+    interrupt_.store(true);
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  frames_.close();
+}
+
+nlohmann::json ViewSession::apply(const nlohmann::json& change) {
+  if (!change.is_object()) throw UsageError("expected a JSON object of fields to change, got " + change.dump());
+  nlohmann::json result;
+  bool exposure_changed = false;
+  float exposure = 0.0f;
+  {
+    const std::lock_guard lock(mu_);
+    driver::RenderArgs a = args_;
+    for (const auto& [key, value] : change.items()) {
+      if (key == "eye") {
+        a.eye = vec_text(vec_field(key, value));
+      } else if (key == "look") {
+        a.look = vec_text(vec_field(key, value));
+      } else if (key == "up") {
+        a.up = vec_text(vec_field(key, value));
+      } else if (key == "fov") {
+        a.fov = double(float(number_field(key, value, 1e-3, 179.0)));
+      } else if (key == "integrator") {
+        if (!value.is_string()) throw UsageError("integrator: expected a name, got " + value.dump());
+        a.integrator = value.get<std::string>();
+        parse_name<Integrator>(kIntegratorNames, a.integrator, "integrator", "integrator");
+      } else if (key == "spp") {
+        a.spp = int_field(key, value, 1, 1 << 20);
+      } else if (key == "max_depth") {
+        a.settings.max_depth = int_field(key, value, 0, 64);
+      } else if (key == "exposure") {
+        a.settings.exposure = float(number_field(key, value, 0.0, 1e6));
+      } else if (key == "width") {
+        a.settings.width = int_field(key, value, 1, kMaxViewSide);
+      } else if (key == "height") {
+        a.settings.height = int_field(key, value, 1, kMaxViewSide);
+      } else {
+        throw UsageError("unknown field '" + key +
+                         "' (eye, look, up, fov, integrator, spp, max_depth, exposure, width, height)");
+      }
+    }
+    // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
+    // looking at its own position or along its up vector).
+    driver::validate(a);
+    const CameraSpec camera = driver::camera_for(scene_, a);
+    std::string note;
+    const RenderSettings settings = driver::settings_for(a, scene_, note);
+    exposure_changed = settings.exposure != job_.settings.exposure;
+    exposure = settings.exposure;
+    const bool restart = a.eye != args_.eye || a.look != args_.look || a.up != args_.up || a.fov != args_.fov ||
+                         a.integrator != args_.integrator || a.spp != args_.spp ||
+                         a.settings.max_depth != args_.settings.max_depth || a.settings.width != args_.settings.width ||
+                         a.settings.height != args_.settings.height;
+    args_ = a;
+    job_.settings.exposure = settings.exposure;
+    if (restart) {
+      job_ = {++generation_, camera, settings};
+      interrupt_.store(true);
+    }
+    result = state_locked();
+  }
+  cv_.notify_all();
+  if (exposure_changed) {
+    {
+      const std::lock_guard lock(display_mu_);
+      exposure_ = exposure;
+      if (display_) display_image_ = tonemap(*display_, exposure_);
+    }
+    publish_display(true);
+  }
+  return result;
+}
+
+nlohmann::json ViewSession::state() const {
+  const std::lock_guard lock(mu_);
+  return state_locked();
+}
+
+nlohmann::json ViewSession::state_locked() const {
+  const CameraSpec& c = job_.camera;
+  return {{"generation", generation_},
+          {"eye", vec_json(c.eye)},
+          {"look", vec_json(c.look)},
+          {"up", vec_json(c.up)},
+          {"fov", c.fov_degrees},
+          {"integrator", args_.integrator},
+          {"spp", *args_.spp},
+          {"max_depth", args_.settings.max_depth},
+          {"exposure", args_.settings.exposure},
+          {"width", args_.settings.width},
+          {"height", args_.settings.height},
+          {"max_side", kMaxViewSide},
+          {"command", render_command(args_, user_flags_, viewer_flags_)},
+          {"scene", scene_.source},
+          {"triangles", scene_.size()},
+          {"scene_size", length(scene_.bounds.extent())},
+          {"accel", std::string(name_of<AccelKind>(kAccelKindNames, accel_.kind))}};
+}
+
+std::optional<ViewSession::Snapshot> ViewSession::snapshot() const {
+  uint64_t generation = 0;
+  {
+    const std::lock_guard lock(mu_);
+    generation = generation_;
+  }
+  const std::lock_guard lock(display_mu_);
+  if (!display_ || display_generation_ != generation) return std::nullopt;
+  return Snapshot{display_image_, *display_, display_spp_};
+}
+
+void ViewSession::render_loop() {
+  uint64_t finished = 0;  // the generation whose accumulation is complete
+  while (true) {
+    Job job;
+    {
+      std::unique_lock lock(mu_);
+      cv_.wait(lock, [&] { return stopping_ || job_.generation != finished; });
+      if (stopping_) return;
+      job = job_;
+      interrupt_.store(false);
+    }
+    if (render_job(job)) finished = job.generation;
+  }
+}
+
+bool ViewSession::render_preview(const Job& job) {
+  const RenderSettings& s = job.settings;
+  const double ns = ns_per_sample_[size_t(s.integrator)];
+  const double full_ms = ns * double(s.width) * double(s.height) * 1e-6;
+  // Unmeasured: a quarter of each side; then whatever fits the budget, or no preview at all.
+  const int scale = ns == 0.0 ? 4 : std::min(16, int(std::ceil(std::sqrt(full_ms / kPreviewBudgetMs))));
+  if (scale <= 1) return true;
+  Job small = job;
+  small.settings.width = std::max(1, (s.width + scale - 1) / scale);
+  small.settings.height = std::max(1, (s.height + scale - 1) / scale);
+  small.settings.spp = 1;
+  Framebuffer fb(small.settings.width, small.settings.height);
+  RenderContext ctx{&scene_, Camera(job.camera, small.settings.width, small.settings.height), small.settings, &fb};
+  ctx.samples = {0, 1};
+  RenderControl control;
+  control.cancel = &interrupt_;
+  const auto t0 = Clock::now();
+  if (!render_image(accel_, ctx, sched_, control)) return false;
+  const double seconds = seconds_since(t0);
+  ns_per_sample_[size_t(s.integrator)] = seconds * 1e9 / double(fb.pixel_count());
+  auto meta = std::make_shared<Frame>();
+  meta->generation = job.generation;
+  meta->spp_target = uint32_t(s.spp);
+  meta->preview = true;
+  meta->frame_ms = seconds * 1e3;
+  meta->msamples_per_s = double(fb.pixel_count()) / seconds * 1e-6;
+  meta->mrays_per_s = double(control.rays_done.load()) / seconds * 1e-6;
+  Image8 image;
+  {
+    const std::lock_guard lock(display_mu_);
+    image = tonemap(fb, exposure_);
+  }
+  publish_image(std::move(image), std::move(meta), false);
+  return !interrupt_.load();
+}
+
+bool ViewSession::render_job(const Job& job) {
+  if (!render_preview(job)) return false;
+  const RenderSettings& s = job.settings;
+  Framebuffer fb(s.width, s.height);
+  RenderContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
+  RenderControl control;
+  control.cancel = &interrupt_;
+  const std::vector<SampleRange> passes = sample_passes(s);
+  const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
+  const auto t_start = Clock::now();
+  size_t tiles_done = 0;
+  for (size_t p = 0; p < passes.size(); ++p) {
+    ctx.samples = passes[p];
+    tiles_done = 0;
+    // After the first pass, each finished tile refines the display at once; the first pass is
+    // shown whole (the preview stands in for it meanwhile).
+    control.on_tile = nullptr;
+    if (p > 0) {
+      control.on_tile = [&](const Tile& tile) {
+        {
+          const std::lock_guard lock(display_mu_);
+          display_->copy_tile(fb, tile);
+          tonemap_tile(*display_, exposure_, tile, display_image_);
+          pass_fraction_ = double(++tiles_done) / double(tile_count);
+        }
+        publish_display(false);
+      };
+    }
+    const auto t_pass = Clock::now();
+    if (!render_image(accel_, ctx, sched_, control)) return false;
+    const double pass_seconds = seconds_since(t_pass);
+    ns_per_sample_[size_t(s.integrator)] = pass_seconds * 1e9 / (double(fb.pixel_count()) * ctx.samples.count);
+    {
+      const std::lock_guard lock(display_mu_);
+      if (p == 0) {
+        display_ = fb;
+        display_image_ = tonemap(fb, exposure_);
+        display_generation_ = job.generation;
+        display_target_ = uint32_t(s.spp);
+      }
+      display_spp_ = ctx.samples.first + ctx.samples.count;
+      pass_fraction_ = 0.0;
+      last_pass_ms_ = pass_seconds * 1e3;
+      accum_seconds_ = seconds_since(t_start);
+      accum_samples_ = uint64_t(fb.pixel_count()) * display_spp_;
+      accum_rays_ = control.rays_done.load();
+    }
+    publish_display(true);
+  }
+  return true;
+}
+
+void ViewSession::publish_display(bool force) {
+  std::unique_lock publish(publish_mu_, std::defer_lock);
+  if (force) {
+    publish.lock();
+  } else if (Clock::now() - last_publish_ < kProgressInterval || !publish.try_lock()) {
+    return;
+  }
+  auto meta = std::make_shared<Frame>();
+  Image8 image;
+  {
+    const std::lock_guard lock(display_mu_);
+    if (!display_) return;
+    image = display_image_;
+    meta->generation = display_generation_;
+    meta->spp = display_spp_;
+    meta->spp_target = display_target_;
+    meta->pass_fraction = pass_fraction_;
+    meta->complete = display_spp_ >= display_target_ && pass_fraction_ == 0.0;
+    meta->frame_ms = last_pass_ms_;
+    if (accum_seconds_ > 0.0) {
+      meta->msamples_per_s = double(accum_samples_) / accum_seconds_ * 1e-6;
+      meta->mrays_per_s = double(accum_rays_) / accum_seconds_ * 1e-6;
+    }
+  }
+  const bool lossless = meta->complete;
+  publish_locked(std::move(image), std::move(meta), lossless);
+}
+
+void ViewSession::publish_image(Image8 image, std::shared_ptr<Frame> meta, bool lossless) {
+  const std::lock_guard publish(publish_mu_);
+  publish_locked(std::move(image), std::move(meta), lossless);
+}
+
+void ViewSession::publish_locked(Image8 image, std::shared_ptr<Frame> meta, bool lossless) {
+  meta->width = image.width;
+  meta->height = image.height;
+  // The finished image exactly (PNG: what `tracer render` writes); JPEG while it refines.
+  meta->mime = lossless ? "image/png" : "image/jpeg";
+  meta->bytes = lossless ? encode_png(image) : encode_jpeg(image, kJpegQuality);
+  frames_.publish(std::move(meta));
+  last_publish_ = Clock::now();
+}
+
+}  // namespace tracer::view

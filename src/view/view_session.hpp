@@ -1,0 +1,130 @@
+// The viewer's renderer: one scene and accelerator, built once, and a view state (camera, integrator,
+// samples, depth, exposure, size) that requests change. A thread renders the state as `tracer
+// render` would (the same flags turned into the same camera and settings, the same passes of
+// render_image) into a display image that refines pass by pass and tile by tile, and publishes
+// frames. A change interrupts the pass in progress within a piece of a tile; while the full image
+// would be slow, a reduced-resolution preview of the new state comes first.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "driver/render_args.hpp"
+#include "film/tone_map.hpp"
+#include "view/frame_store.hpp"
+
+namespace tracer::view {
+
+// The largest image the viewer renders, per side: its framebuffers stay under 300 MB.
+inline constexpr int kMaxViewSide = 4096;
+
+// The flags of a `tracer render` command that the viewer's state sets, each taking one value. The
+// viewer's "copy command" drops them from the user's own flags and writes the current ones.
+inline constexpr const char* kStateFlags[] = {"--eye",        "-v",          "--look",     "--up",
+                                              "--fov",        "--width",     "--height",   "--spp",
+                                              "--integrator", "--max-depth", "--exposure", "-l"};
+
+// The command line of `tracer render` for `args`: `user_flags` (the view command's own arguments)
+// without the state's flags and the viewer's own (`viewer_flags`, each taking one value), then the
+// state's, every value written so that it parses back to the same float. Shell-quoted.
+std::string render_command(const driver::RenderArgs& args, const std::vector<std::string>& user_flags,
+                           const std::vector<std::string>& viewer_flags);
+
+// Quotes a word for a POSIX shell when it needs it.
+std::string shell_quote(const std::string& word);
+
+class ViewSession {
+ public:
+  // `args`: the view command's flags (the state starts from them); `user_flags`: its arguments as
+  // given, for the copied command. The scene and accelerator must outlive the session.
+  ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args,
+              std::vector<std::string> user_flags, std::vector<std::string> viewer_flags);
+  ~ViewSession();
+  ViewSession(const ViewSession&) = delete;
+  ViewSession& operator=(const ViewSession&) = delete;
+
+  void start();
+  // Interrupts the render and joins its thread; frames() is closed. Idempotent.
+  void stop();
+
+  // Applies a change: a JSON object of any of eye, look, up ([x, y, z]), fov, integrator, spp,
+  // max_depth, exposure, width, height. Throws UsageError naming the field for an unknown field,
+  // a wrong type or a bad value; then nothing changes. Returns the new state.
+  nlohmann::json apply(const nlohmann::json& change);
+  // The state: the fields above, "generation" (counts changes that restart the accumulation),
+  // "command" (the render command of this state) and the scene's facts.
+  nlohmann::json state() const;
+
+  FrameStore& frames() { return frames_; }
+
+  // The accumulated image as it is now (every finished tile of every finished pass), tone-mapped
+  // or as radiance; nullopt before the first pass of the current state has finished.
+  struct Snapshot {
+    Image8 image;
+    Framebuffer radiance{1, 1};
+    uint32_t spp = 0;
+  };
+  std::optional<Snapshot> snapshot() const;
+
+ private:
+  struct Job {
+    uint64_t generation = 0;
+    CameraSpec camera;
+    RenderSettings settings;
+  };
+  void render_loop();
+  bool render_job(const Job& job);
+  bool render_preview(const Job& job);
+  // Encodes the display (or `preview`) and publishes it; call without display_mu_ held.
+  void publish_display(bool force);
+  void publish_image(Image8 image, std::shared_ptr<Frame> meta, bool lossless);
+  void publish_locked(Image8 image, std::shared_ptr<Frame> meta, bool lossless);  // publish_mu_ held
+  nlohmann::json state_locked() const;
+
+  const Scene& scene_;
+  const Accelerator& accel_;
+  const SchedOptions sched_;
+  const std::vector<std::string> user_flags_, viewer_flags_;
+
+  // The state, guarded by mu_; a change bumps generation_ and sets interrupt_ under it.
+  mutable std::mutex mu_;
+  std::condition_variable cv_;
+  driver::RenderArgs args_;
+  Job job_;
+  uint64_t generation_ = 1;
+  bool stopping_ = false;
+  std::atomic<bool> interrupt_{false};
+
+  // The display: what the page sees of the accumulation, guarded by display_mu_.
+  mutable std::mutex display_mu_;
+  std::optional<Framebuffer> display_;  // copied from the render's film as tiles finish
+  Image8 display_image_;
+  float exposure_ = 1.0f;
+  uint64_t display_generation_ = 0;
+  uint32_t display_spp_ = 0, display_target_ = 0;
+  double pass_fraction_ = 0.0, last_pass_ms_ = 0.0;
+  double accum_seconds_ = 0.0;  // rendering time of the state's accumulation so far
+  uint64_t accum_samples_ = 0, accum_rays_ = 0;
+
+  std::mutex publish_mu_;  // one publication at a time; progress frames skip when busy
+  std::chrono::steady_clock::time_point last_publish_{};
+
+  // Nanoseconds per pixel sample of each integrator, measured: sizes the preview.
+  std::array<double, 3> ns_per_sample_{0.0, 0.0, 0.0};
+
+  FrameStore frames_;
+  std::thread thread_;
+};
+
+}  // namespace tracer::view
