@@ -15,7 +15,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // A preview is sized to render within this; the full image follows it.
-constexpr double kPreviewBudgetMs = 40.0;
+constexpr double kPreviewBudgetMs = 30.0;
+// Changes closer together than this are a camera in motion: after its preview the renderer waits
+// up to kMotionPause for the next change before starting the full image, leaving the cores to the
+// browser (on the same machine, it decodes and draws the frames) rather than to a pass the next
+// move would interrupt.
+constexpr auto kMotionInterval = std::chrono::milliseconds(150);
+constexpr auto kMotionPause = std::chrono::milliseconds(100);
 // Frames of a pass in progress (tiles refined so far) come at most this often.
 constexpr auto kProgressInterval = std::chrono::milliseconds(200);
 constexpr int kJpegQuality = 88;
@@ -129,6 +135,7 @@ void ViewSession::stop() {
     const std::lock_guard lock(mu_);
     stopping_ = true;
     interrupt_.store(true);
+    stop_.store(true);
   }
   cv_.notify_all();
   if (thread_.joinable()) thread_.join();
@@ -186,7 +193,9 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     args_ = a;
     job_.settings.exposure = settings.exposure;
     if (restart) {
-      job_ = {++generation_, camera, settings};
+      const auto now = Clock::now();
+      job_ = {++generation_, camera, settings, now - last_change_ < kMotionInterval};
+      last_change_ = now;
       interrupt_.store(true);
     }
     result = state_locked();
@@ -240,6 +249,13 @@ std::optional<ViewSession::Snapshot> ViewSession::snapshot() const {
   return Snapshot{display_image_, *display_, display_spp_};
 }
 
+void ViewSession::measured_cost(Integrator integrator, double seconds, uint64_t samples) {
+  double& ns = ns_per_sample_[size_t(integrator)];
+  const double now = seconds * 1e9 / double(std::max<uint64_t>(samples, 1));
+  // Up at once, down gently: a preview too small for a moment beats a frame that comes late.
+  ns = now >= ns ? now : 0.5 * (ns + now);
+}
+
 void ViewSession::render_loop() {
   uint64_t finished = 0;  // the generation whose accumulation is complete
   while (true) {
@@ -255,13 +271,17 @@ void ViewSession::render_loop() {
   }
 }
 
-bool ViewSession::render_preview(const Job& job) {
+bool ViewSession::render_preview(const Job& job, bool& skipped) {
+  skipped = false;
   const RenderSettings& s = job.settings;
   const double ns = ns_per_sample_[size_t(s.integrator)];
   const double full_ms = ns * double(s.width) * double(s.height) * 1e-6;
   // Unmeasured: a quarter of each side; then whatever fits the budget, or no preview at all.
   const int scale = ns == 0.0 ? 4 : std::min(16, int(std::ceil(std::sqrt(full_ms / kPreviewBudgetMs))));
-  if (scale <= 1) return true;
+  if (scale <= 1) {
+    skipped = true;
+    return true;
+  }
   Job small = job;
   small.settings.width = std::max(1, (s.width + scale - 1) / scale);
   small.settings.height = std::max(1, (s.height + scale - 1) / scale);
@@ -269,12 +289,14 @@ bool ViewSession::render_preview(const Job& job) {
   Framebuffer fb(small.settings.width, small.settings.height);
   RenderContext ctx{&scene_, Camera(job.camera, small.settings.width, small.settings.height), small.settings, &fb};
   ctx.samples = {0, 1};
+  // Only a stop ends a preview: it is short, and interrupting it for the next move's would leave
+  // a fast-moving camera with no frame at all.
   RenderControl control;
-  control.cancel = &interrupt_;
+  control.cancel = &stop_;
   const auto t0 = Clock::now();
   if (!render_image(accel_, ctx, sched_, control)) return false;
   const double seconds = seconds_since(t0);
-  ns_per_sample_[size_t(s.integrator)] = seconds * 1e9 / double(fb.pixel_count());
+  measured_cost(s.integrator, seconds, fb.pixel_count());
   auto meta = std::make_shared<Frame>();
   meta->generation = job.generation;
   meta->spp_target = uint32_t(s.spp);
@@ -292,12 +314,16 @@ bool ViewSession::render_preview(const Job& job) {
 }
 
 bool ViewSession::render_job(const Job& job) {
-  if (!render_preview(job)) return false;
+  bool no_preview = false;
+  if (!render_preview(job, no_preview)) return false;
+  if (job.in_motion) {
+    std::unique_lock lock(mu_);
+    if (cv_.wait_for(lock, kMotionPause, [&] { return stopping_ || job_.generation != job.generation; })) return false;
+  }
   const RenderSettings& s = job.settings;
   Framebuffer fb(s.width, s.height);
   RenderContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
   RenderControl control;
-  control.cancel = &interrupt_;
   const std::vector<SampleRange> passes = sample_passes(s);
   const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
   const auto t_start = Clock::now();
@@ -319,10 +345,16 @@ bool ViewSession::render_job(const Job& job) {
         publish_display(false);
       };
     }
+    // A first pass quick enough to stand for the preview is not interrupted either.
+    control.cancel = p == 0 && no_preview ? &stop_ : &interrupt_;
     const auto t_pass = Clock::now();
-    if (!render_image(accel_, ctx, sched_, control)) return false;
+    const uint64_t samples_before = control.pixels_done.load();
+    const bool finished = render_image(accel_, ctx, sched_, control);
     const double pass_seconds = seconds_since(t_pass);
-    ns_per_sample_[size_t(s.integrator)] = pass_seconds * 1e9 / (double(fb.pixel_count()) * ctx.samples.count);
+    // An interrupted pass counts too: a camera that turned from the sky to the scene must not keep
+    // the sky's cost, or every move would start a full image and be interrupted before a frame.
+    measured_cost(s.integrator, pass_seconds, control.pixels_done.load() - samples_before);
+    if (!finished) return false;
     {
       const std::lock_guard lock(display_mu_);
       if (p == 0) {

@@ -82,10 +82,14 @@ class ViewSession {
     uint64_t generation = 0;
     CameraSpec camera;
     RenderSettings settings;
+    bool in_motion = false;  // came soon after the change before it
   };
   void render_loop();
   bool render_job(const Job& job);
-  bool render_preview(const Job& job);
+  // Renders and publishes the preview of a new state, unless the full image is quick enough
+  // (`skipped`); false if stopped.
+  bool render_preview(const Job& job, bool& skipped);
+  void measured_cost(Integrator integrator, double seconds, uint64_t samples);
   // Encodes the display (or `preview`) and publishes it; call without display_mu_ held.
   void publish_display(bool force);
   void publish_image(Image8 image, std::shared_ptr<Frame> meta, bool lossless);
@@ -103,8 +107,10 @@ class ViewSession {
   driver::RenderArgs args_;
   Job job_;
   uint64_t generation_ = 1;
+  std::chrono::steady_clock::time_point last_change_{};
   bool stopping_ = false;
   std::atomic<bool> interrupt_{false};
+  std::atomic<bool> stop_{false};  // set once, by stop()
 
   // The display: what the page sees of the accumulation, guarded by display_mu_.
   mutable std::mutex display_mu_;
