@@ -3,7 +3,7 @@
 # the study's table, the scheduler scaling at 1 and 2 threads, the per-task overhead, our variants
 # with Embree on all scenes, the Google Benchmark microbenchmarks, then path tracing beside Embree
 # (scripts/benchmarks-path.sh), tracer-mpi (scripts/benchmarks-mpi.sh) and the scaling from 100k to
-# 5M triangles (scripts/benchmarks-scale.sh), builds (scripts/benchmarks-build.sh), loading (scripts/benchmarks-load.sh). Outputs go to docs/bench/.
+# 5M triangles (scripts/benchmarks-scale.sh), builds (scripts/benchmarks-build.sh), loading (scripts/benchmarks-load.sh), the viewer (scripts/benchmarks-view.sh). Outputs go to docs/bench/.
 # Run from the project root with ../shared/scenes beside it, on an otherwise idle machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -85,4 +85,6 @@ scripts/benchmarks-scale.sh
 scripts/benchmarks-build.sh
 # 7. Loading: the OBJ parser against tinyobjloader.
 scripts/benchmarks-load.sh
+# 8. tracer view in the browser: move to frame, frames per second.
+scripts/benchmarks-view.sh
 echo "figures written to $O/"
