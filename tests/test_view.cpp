@@ -180,6 +180,40 @@ TEST_F(ViewServerTest, FinishedImageIsTheCopiedCommandsRender) {
   }
 }
 
+// A raised target goes on from the film (no preview, no pass again) and still ends on render's
+// image; a lowered one starts again.
+TEST_F(ViewServerTest, RaisingTheTargetGoesOnFromTheFilm) {
+  ASSERT_EQ(post(R"({"spp": 4, "eye": [0.2, 1, 2.8]})")->status, 200);
+  const auto at4 = complete_frame();
+  ASSERT_TRUE(at4);
+  ASSERT_EQ(post(R"({"spp": 16})")->status, 200);
+  const uint64_t raised = session_->state()["generation"];
+  std::vector<std::shared_ptr<const view::Frame>> frames;
+  for (uint64_t seen = at4->seq;;) {
+    auto f = session_->frames().wait_newer(seen, std::chrono::seconds(60));
+    ASSERT_TRUE(f);
+    seen = f->seq;
+    if (f->generation == raised) frames.push_back(f);
+    if (f->generation == raised && f->complete) break;
+  }
+  for (const auto& f : frames) {
+    EXPECT_FALSE(f->preview);
+    // Past the film's 4 samples, or on the way there within the pass that follows them.
+    EXPECT_TRUE(f->spp > 4u || (f->spp == 4u && f->pass_fraction > 0.0)) << f->spp << " " << f->pass_fraction;
+  }
+  std::ofstream(dir_ + "/view.png", std::ios::binary) << frames.back()->bytes;
+  ASSERT_EQ(run_copied_command(dir_ + "/render.png").exit_code, 0);
+  EXPECT_EQ(read_image(dir_ + "/view.png").rgb, read_image(dir_ + "/render.png").rgb);
+
+  ASSERT_EQ(post(R"({"spp": 8})")->status, 200);
+  const auto lowered = complete_frame();
+  ASSERT_TRUE(lowered);
+  EXPECT_EQ(lowered->spp, 8u);
+  std::ofstream(dir_ + "/view.png", std::ios::binary) << lowered->bytes;
+  ASSERT_EQ(run_copied_command(dir_ + "/render.png").exit_code, 0);
+  EXPECT_EQ(read_image(dir_ + "/view.png").rgb, read_image(dir_ + "/render.png").rgb);
+}
+
 TEST_F(ViewServerTest, EventStreamsGetTheNewestFrameEachSeveralAtOnce) {
   ASSERT_EQ(post(R"({"spp": 2})")->status, 200);
   ASSERT_TRUE(complete_frame());

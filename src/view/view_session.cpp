@@ -120,7 +120,8 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
   std::string note;
   const RenderSettings settings = driver::settings_for(args_, scene_, note);
   args_.spp = settings.spp;
-  job_ = {generation_, driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note)};
+  job_ = {generation_, driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note), false,
+          generation_};
   exposure_ = settings.exposure;
 }
 
@@ -186,17 +187,21 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     const RenderSettings settings = driver::settings_for(a, scene_, note);
     exposure_changed = settings.exposure != job_.settings.exposure;
     exposure = settings.exposure;
-    const bool restart = a.eye != args_.eye || a.look != args_.look || a.up != args_.up || a.fov != args_.fov ||
-                         a.integrator != args_.integrator || a.spp != args_.spp ||
-                         a.settings.max_depth != args_.settings.max_depth || a.settings.width != args_.settings.width ||
-                         a.settings.height != args_.settings.height;
+    const bool same_view = a.eye == args_.eye && a.look == args_.look && a.up == args_.up && a.fov == args_.fov &&
+                           a.integrator == args_.integrator && a.settings.max_depth == args_.settings.max_depth &&
+                           a.settings.width == args_.settings.width && a.settings.height == args_.settings.height;
+    const bool restart = !same_view || a.spp != args_.spp;
+    const bool raised = same_view && *a.spp > *args_.spp;
     args_ = a;
     job_.settings.exposure = settings.exposure;
     if (restart) {
       const auto now = Clock::now();
-      job_ = {++generation_, camera, settings, now - last_change_ < kMotionInterval};
+      // Only the target changed: the new state may go on from the film (render_job says when).
+      const uint64_t film_base = same_view ? job_.film_base : generation_ + 1;
+      // A raised target lets the pass in progress finish, to go on from it.
+      if (!raised) interrupt_.store(true);
+      job_ = {++generation_, camera, settings, now - last_change_ < kMotionInterval, film_base};
       last_change_ = now;
-      interrupt_.store(true);
     }
     result = state_locked();
   }
@@ -314,21 +319,41 @@ bool ViewSession::render_preview(const Job& job, bool& skipped) {
 }
 
 bool ViewSession::render_job(const Job& job) {
-  bool no_preview = false;
-  if (!render_preview(job, no_preview)) return false;
-  if (job.in_motion) {
-    std::unique_lock lock(mu_);
-    if (cv_.wait_for(lock, kMotionPause, [&] { return stopping_ || job_.generation != job.generation; })) return false;
-  }
   const RenderSettings& s = job.settings;
-  Framebuffer fb(s.width, s.height);
+  const std::vector<SampleRange> passes = sample_passes(s);
+  // A state that only raised the samples per pixel of the film's goes on from the film's last
+  // pass, when the new schedule has a pass boundary there (so the image stays tracer render's).
+  size_t first_pass = 0;
+  if (film_ && film_base_ == job.film_base) {
+    for (size_t p = 0; p < passes.size(); ++p) {
+      if (passes[p].first + passes[p].count == film_done_) first_pass = p + 1;
+    }
+  }
+  bool no_preview = first_pass > 0;
+  if (first_pass == 0) {
+    if (!render_preview(job, no_preview)) return false;
+    if (job.in_motion) {
+      std::unique_lock lock(mu_);
+      if (cv_.wait_for(lock, kMotionPause, [&] { return stopping_ || job_.generation != job.generation; })) {
+        return false;
+      }
+    }
+    film_.emplace(s.width, s.height);
+    film_done_ = 0;
+  } else {
+    const std::lock_guard lock(display_mu_);
+    display_generation_ = job.generation;
+    display_target_ = uint32_t(s.spp);
+  }
+  film_base_ = job.film_base;
+  Framebuffer& fb = *film_;
   RenderContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
   RenderControl control;
-  const std::vector<SampleRange> passes = sample_passes(s);
   const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
   const auto t_start = Clock::now();
+  const uint32_t resumed_at = film_done_;
   size_t tiles_done = 0;
-  for (size_t p = 0; p < passes.size(); ++p) {
+  for (size_t p = first_pass; p < passes.size(); ++p) {
     ctx.samples = passes[p];
     tiles_done = 0;
     // After the first pass, each finished tile refines the display at once; the first pass is
@@ -354,7 +379,11 @@ bool ViewSession::render_job(const Job& job) {
     // An interrupted pass counts too: a camera that turned from the sky to the scene must not keep
     // the sky's cost, or every move would start a full image and be interrupted before a frame.
     measured_cost(s.integrator, pass_seconds, control.pixels_done.load() - samples_before);
-    if (!finished) return false;
+    if (!finished) {
+      film_.reset();  // part of a pass: no state can go on from it
+      return false;
+    }
+    film_done_ = ctx.samples.first + ctx.samples.count;
     {
       const std::lock_guard lock(display_mu_);
       if (p == 0) {
@@ -363,15 +392,16 @@ bool ViewSession::render_job(const Job& job) {
         display_generation_ = job.generation;
         display_target_ = uint32_t(s.spp);
       }
-      display_spp_ = ctx.samples.first + ctx.samples.count;
+      display_spp_ = film_done_;
       pass_fraction_ = 0.0;
       last_pass_ms_ = pass_seconds * 1e3;
       accum_seconds_ = seconds_since(t_start);
-      accum_samples_ = uint64_t(fb.pixel_count()) * display_spp_;
+      accum_samples_ = uint64_t(fb.pixel_count()) * (film_done_ - resumed_at);
       accum_rays_ = control.rays_done.load();
     }
     publish_display(true);
   }
+  if (first_pass == passes.size()) publish_display(true);  // the film already holds them all
   return true;
 }
 

@@ -83,6 +83,8 @@ class ViewSession {
     CameraSpec camera;
     RenderSettings settings;
     bool in_motion = false;  // came soon after the change before it
+    // The first state of a chain that changed only the samples per pixel: its film may go on.
+    uint64_t film_base = 0;
   };
   void render_loop();
   bool render_job(const Job& job);
@@ -125,6 +127,11 @@ class ViewSession {
 
   std::mutex publish_mu_;  // one publication at a time; progress frames skip when busy
   std::chrono::steady_clock::time_point last_publish_{};
+
+  // The render thread's film: the state chain it belongs to and the samples per pixel it holds.
+  std::optional<Framebuffer> film_;
+  uint64_t film_base_ = 0;
+  uint32_t film_done_ = 0;
 
   // Nanoseconds per pixel sample of each integrator, measured: sizes the preview.
   std::array<double, 3> ns_per_sample_{0.0, 0.0, 0.0};
