@@ -255,8 +255,9 @@ std::optional<ViewSession::Snapshot> ViewSession::snapshot() const {
 }
 
 void ViewSession::measured_cost(Integrator integrator, double seconds, uint64_t samples) {
+  if (samples == 0) return;  // interrupted before any piece finished: says nothing
   double& ns = ns_per_sample_[size_t(integrator)];
-  const double now = seconds * 1e9 / double(std::max<uint64_t>(samples, 1));
+  const double now = seconds * 1e9 / double(samples);
   // Up at once, down gently: a preview too small for a moment beats a frame that comes late.
   ns = now >= ns ? now : 0.5 * (ns + now);
 }
