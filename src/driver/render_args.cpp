@@ -1,5 +1,7 @@
 #include "driver/render_args.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -2,8 +2,6 @@
 // an accelerator and a scheduler.
 #pragma once
 
-#include <CLI/CLI.hpp>
-
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +12,10 @@
 #include "render/render_tile.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/scene.hpp"
+
+namespace CLI {
+class App;  // CLI11: only the files that add or parse flags include it (a heavy header)
+}
 
 namespace tracer::driver {
 

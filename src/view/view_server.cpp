@@ -2,6 +2,7 @@
 
 #include <httplib.h>
 #include <openssl/evp.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <random>

@@ -1,5 +1,7 @@
 #include "view/view_session.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

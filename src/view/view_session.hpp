@@ -6,7 +6,7 @@
 // would be slow, a reduced-resolution preview of the new state comes first.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <array>
 #include <atomic>
