@@ -163,7 +163,11 @@ void write_image(const std::string& path, const Image8& image) {
     bytes = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
     bytes.append(reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
   } else {
-    bytes = encode_png(image);
+    try {
+      bytes = encode_png(image);
+    } catch (const InputError& e) {
+      throw InputError(path + ": " + e.what());
+    }
   }
   write_file_atomic(path, bytes);
 }

@@ -61,14 +61,12 @@ int run_view(ViewArgs args) {
   }
   session.stop();  // the pass in progress stops within a piece of a tile
   server.stop();
+  std::cerr << "tracer: " << stop_signal_name() << std::endl;
   // Idle keep-alive connections of a browser may hold the server's threads for up to a second;
   // nothing is left to write, so the process does not wait for them.
   if (listening.wait_for(std::chrono::milliseconds(300)) != std::future_status::ready) {
-    std::cerr << "tracer: " << stop_signal_name() << "\n";
-    std::fflush(stderr);
     std::_Exit(exit_code_for_stop());
   }
-  std::cerr << "tracer: " << stop_signal_name() << "\n";
   return exit_code_for_stop();
 }
 

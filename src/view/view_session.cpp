@@ -113,7 +113,8 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
       user_flags_(std::move(user_flags)),
       viewer_flags_(std::move(viewer_flags)),
       args_(args) {
-  // Every state flag explicit, so the copied command says exactly what is shown.
+  // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
+  // and settings are then derived from those explicit flags, as the command's will be.
   const CameraSpec camera = driver::camera_for(scene_, args_);
   args_.eye = vec_text(camera.eye);
   args_.look = vec_text(camera.look);
@@ -136,7 +137,6 @@ void ViewSession::start() {
 void ViewSession::stop() {
   {
     const std::lock_guard lock(mu_);
-    stopping_ = true;
     interrupt_.store(true);
     stop_.store(true);
   }
@@ -270,8 +270,8 @@ void ViewSession::render_loop() {
     Job job;
     {
       std::unique_lock lock(mu_);
-      cv_.wait(lock, [&] { return stopping_ || job_.generation != finished; });
-      if (stopping_) return;
+      cv_.wait(lock, [&] { return stop_.load() || job_.generation != finished; });
+      if (stop_.load()) return;
       job = job_;
       interrupt_.store(false);
     }
@@ -337,7 +337,7 @@ bool ViewSession::render_job(const Job& job) {
     if (!render_preview(job, no_preview)) return false;
     if (job.in_motion) {
       std::unique_lock lock(mu_);
-      if (cv_.wait_for(lock, kMotionPause, [&] { return stopping_ || job_.generation != job.generation; })) {
+      if (cv_.wait_for(lock, kMotionPause, [&] { return stop_.load() || job_.generation != job.generation; })) {
         return false;
       }
     }

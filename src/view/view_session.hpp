@@ -89,10 +89,11 @@ class ViewSession {
   void render_loop();
   bool render_job(const Job& job);
   // Renders and publishes the preview of a new state, unless the full image is quick enough
-  // (`skipped`); false if stopped.
+  // (`skipped`); false if stopped or changed meanwhile.
   bool render_preview(const Job& job, bool& skipped);
   void measured_cost(Integrator integrator, double seconds, uint64_t samples);
-  // Encodes the display (or `preview`) and publishes it; call without display_mu_ held.
+  // Encodes the display and publishes it (`force`: now, else at most every progress interval);
+  // call without display_mu_ held.
   void publish_display(bool force);
   void publish_image(Image8 image, std::shared_ptr<Frame> meta, bool lossless);
   void publish_locked(Image8 image, std::shared_ptr<Frame> meta, bool lossless);  // publish_mu_ held
@@ -110,9 +111,8 @@ class ViewSession {
   Job job_;
   uint64_t generation_ = 1;
   std::chrono::steady_clock::time_point last_change_{};
-  bool stopping_ = false;
-  std::atomic<bool> interrupt_{false};
-  std::atomic<bool> stop_{false};  // set once, by stop()
+  std::atomic<bool> interrupt_{false};  // ends the pass in progress: a change, or stop()
+  std::atomic<bool> stop_{false};       // set once, by stop(); ends previews too
 
   // The display: what the page sees of the accumulation, guarded by display_mu_.
   mutable std::mutex display_mu_;
