@@ -1,0 +1,182 @@
+// The samplers: the stratification of the Sobol-Burley sequence, and the environment map's
+// importance sampling against its own density (chi-square) and against the sphere (it integrates
+// to one).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "math/sobol.hpp"
+#include "scene/environment_map.hpp"
+
+namespace tracer {
+namespace {
+
+TEST(Sobol, UnscrambledPointsAreTheSobolSequence) {
+  // Dimension 0 is the van der Corput sequence; dimension 1 (x + 1) the classic second one.
+  const double d0[8] = {0, 0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875};
+  const double d1[8] = {0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875};
+  for (uint32_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(sobol_point(i, 0) * 0x1p-32, d0[i]) << i;
+    EXPECT_EQ(sobol_point(i, 1) * 0x1p-32, d1[i]) << i;
+  }
+  // Each dimension alone: the first 2^m points fill the 2^m intervals of width 2^-m once each.
+  for (int d = 0; d < 4; ++d) {
+    for (uint32_t m = 0; m <= 10; ++m) {
+      std::vector<int> seen(1u << m, 0);
+      for (uint32_t i = 0; i < (1u << m); ++i) ++seen[m == 0 ? 0 : sobol_point(i, d) >> (32 - m)];
+      for (int c : seen) ASSERT_EQ(c, 1) << "dim " << d << ", m " << m;
+    }
+  }
+}
+
+// The first 2^m samples of a pixel put exactly one point in every elementary interval of area
+// 2^-m of dimensions 0 and 1 (a (0,m,2)-net), and one in every interval of width 2^-m of each
+// dimension alone: for every pixel, dimension set and m up to 12.
+TEST(Sobol, FirstPowerOfTwoSamplesOfAPixelAreStratified) {
+  for (uint32_t pixel : {0u, 1u, 77u, 123456u}) {
+    for (uint32_t set : {0u, 1u, 5u, 31u}) {
+      const PixelSampler first(pixel, 0, 3);
+      for (uint32_t m = 0; m <= 12; ++m) {
+        const uint32_t n = 1u << m;
+        std::vector<std::array<float, 4>> pts(n);
+        for (uint32_t i = 0; i < n; ++i) pts[i] = PixelSampler(pixel, i, 3).get<4>(set);
+        for (uint32_t a = 0; a <= m; ++a) {  // intervals of 2^-a by 2^-(m-a)
+          std::vector<int> seen(n, 0);
+          for (const auto& p : pts) {
+            const uint32_t x = uint32_t(p[0] * float(1u << a)), y = uint32_t(p[1] * float(1u << (m - a)));
+            ++seen[(y << a) | x];
+          }
+          for (int c : seen) ASSERT_EQ(c, 1) << "pixel " << pixel << " set " << set << " m " << m << " a " << a;
+        }
+        for (int d = 0; d < 4; ++d) {
+          std::vector<int> seen(n, 0);
+          for (const auto& p : pts) ++seen[uint32_t(p[d] * float(n))];
+          for (int c : seen) ASSERT_EQ(c, 1) << "dimension " << d << " m " << m;
+        }
+      }
+      // Fewer dimensions are the same numbers: get<N> is a prefix of get<4>.
+      EXPECT_EQ(first.get<2>(set)[1], first.get<4>(set)[1]);
+      EXPECT_EQ(first.get<1>(set)[0], first.get<4>(set)[0]);
+    }
+  }
+}
+
+TEST(Sobol, SetsAndPixelsAreScrambledApart) {
+  // Different sets and pixels give different points for the same sample (independent scrambles),
+  // and one (pixel, sample, set) always the same.
+  const PixelSampler s(5, 9, 0);
+  EXPECT_NE(s.get<2>(0), s.get<2>(1));
+  EXPECT_NE(s.get<2>(0), PixelSampler(6, 9, 0).get<2>(0));
+  EXPECT_NE(s.get<2>(0), PixelSampler(5, 9, 1).get<2>(0));
+  EXPECT_EQ(s.get<3>(7), PixelSampler(5, 9, 0).get<3>(7));
+  // Samples past 2^20 still differ from each other.
+  EXPECT_NE(PixelSampler(5, (1u << 20) + 1, 0).get<2>(0), PixelSampler(5, (1u << 20) + 2, 0).get<2>(0));
+}
+
+// A 32 x 16 map: a gradient from the top, a bright patch, a black band and one coloured texel.
+EnvironmentMap test_map(float rotation) {
+  const int w = 32, h = 16;
+  std::vector<Vec3> texels(size_t(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Vec3 v{1.0f + float(h - y)};
+      if (x >= 20 && x < 24 && y >= 3 && y < 6) v = Vec3{200.0f};
+      if (y == 10) v = Vec3{0.0f};
+      texels[size_t(y) * w + size_t(x)] = v;
+    }
+  texels[size_t(12) * w + 3] = Vec3{0.0f, 0.0f, 40.0f};  // blue only: luminance from B alone
+  return EnvironmentMap(w, h, std::move(texels), rotation);
+}
+
+TEST(EnvironmentMap, DensityIntegratesToOneOverTheSphere) {
+  for (const float rotation : {0.0f, 73.0f}) {
+    const EnvironmentMap map = test_map(rotation);
+    // Midpoint rule in (theta, phi) on a grid finer than the texels.
+    const int nt = 512, np = 1024;
+    double sum = 0.0;
+    const double pi = std::numbers::pi;
+    for (int i = 0; i < nt; ++i) {
+      const double theta = pi * (i + 0.5) / nt;
+      for (int j = 0; j < np; ++j) {
+        const double phi = 2 * pi * (j + 0.5) / np;
+        const Vec3 d{float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                     float(std::sin(theta) * std::sin(phi))};
+        sum += map.pdf(d) * std::sin(theta) * (pi / nt) * (2 * pi / np);
+      }
+    }
+    EXPECT_NEAR(sum, 1.0, 2e-3) << rotation;
+  }
+}
+
+TEST(EnvironmentMap, SamplesFollowTheirDensityChiSquare) {
+  // Directions drawn from the map, counted in a 24 x 12 grid of (phi, cos theta) cells (not the
+  // texels'), against each cell's probability integrated from pdf(). The statistic of a correct
+  // sampler is below the 0.1 % quantile of chi-square with the grid's degrees of freedom; a
+  // sampler off by a cell's row or by sin(theta) is far above it.
+  const EnvironmentMap map = test_map(30.0f);
+  const int nphi = 24, nz = 12, n = 200000;
+  std::vector<double> observed(nphi * nz, 0.0), expected(nphi * nz, 0.0);
+  const auto cell = [&](Vec3 d) {
+    const double phi = std::atan2(double(d.z), double(d.x)) + std::numbers::pi;
+    const int i = std::min(int(phi / (2 * std::numbers::pi) * nphi), nphi - 1);
+    const int j = std::min(int((double(d.y) + 1.0) / 2.0 * nz), nz - 1);
+    return j * nphi + i;
+  };
+  int mismatched = 0;
+  for (int k = 0; k < n; ++k) {
+    const std::array<float, 2> u = PixelSampler(uint32_t(k) >> 10, uint32_t(k) & 1023u, 11).get<2>(0);
+    Vec3 d;
+    float pdf = 0.0f;
+    ASSERT_TRUE(map.sample(u[0], u[1], d, pdf));
+    ASSERT_NEAR(length(d), 1.0f, 1e-5f);
+    // The density returned is pdf()'s, but for the rare direction that rounds into the next texel.
+    if (std::fabs(pdf - map.pdf(d)) > 1e-2f * pdf) ++mismatched;
+    observed[cell(d)] += 1.0;
+  }
+  EXPECT_LT(mismatched, n / 1000);
+  // Expected counts: pdf integrated over each cell (uniform in phi and z = cos theta: dw = dphi dz).
+  const int sub = 32;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nphi; ++i)
+      for (int a = 0; a < sub; ++a)
+        for (int b = 0; b < sub; ++b) {
+          const double phi = (i + (a + 0.5) / sub) / nphi * 2 * std::numbers::pi - std::numbers::pi;
+          const double z = (j + (b + 0.5) / sub) / nz * 2.0 - 1.0, r = std::sqrt(1.0 - z * z);
+          const Vec3 d{float(r * std::cos(phi)), float(z), float(r * std::sin(phi))};
+          expected[j * nphi + i] += map.pdf(d) * (2 * std::numbers::pi / nphi / sub) * (2.0 / nz / sub) * n;
+        }
+  double chi2 = 0.0;
+  int dof = -1;
+  for (size_t c = 0; c < observed.size(); ++c) {
+    if (expected[c] < 5.0) {
+      EXPECT_LE(observed[c], 20.0) << "cell " << c;  // (almost) never drawn where the density is ~0
+      continue;
+    }
+    chi2 += (observed[c] - expected[c]) * (observed[c] - expected[c]) / expected[c];
+    ++dof;
+  }
+  // The 0.1 % quantile of chi-square(dof) by the Wilson-Hilferty approximation.
+  const double z = 3.09, k = dof;
+  const double quantile = k * std::pow(1.0 - 2.0 / (9 * k) + z * std::sqrt(2.0 / (9 * k)), 3.0);
+  EXPECT_LT(chi2, quantile) << "dof " << dof;
+}
+
+TEST(EnvironmentMap, RadianceIsTheTexelTheDirectionFallsIn) {
+  const EnvironmentMap map = test_map(0.0f);
+  // Straight up: the top row, whose value is 1 + 16.
+  EXPECT_EQ(map.radiance(Vec3{0.0f, 1.0f, 0.0f}).x, 17.0f);
+  // Turned by 90 degrees, what was at +x is at +z (phi = atan2(z, x) grows toward +z).
+  const EnvironmentMap turned = test_map(90.0f);
+  for (const Vec3 d : {Vec3{0.6f, 0.3f, 0.2f}, Vec3{-0.1f, -0.7f, 0.5f}}) {
+    const Vec3 rd{-d.z, d.y, d.x};  // d turned by -90 degrees about +y
+    EXPECT_EQ(turned.radiance(normalize(d)).z, map.radiance(normalize(rd)).z);
+  }
+  // Negative and non-finite texels read as black.
+  const EnvironmentMap bad(2, 1, {Vec3{-1.0f, NAN, INFINITY}, Vec3{1.0f}});
+  EXPECT_EQ(bad.radiance(Vec3{-1.0f, 0.0f, 0.01f}).x + bad.radiance(Vec3{-1.0f, 0.0f, 0.01f}).y, 0.0f);
+}
+
+}  // namespace
+}  // namespace tracer
