@@ -42,6 +42,8 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ + "/empty.obj") << "# nothing\n";
     std::ofstream(dir_ + "/ok.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
     std::ofstream(dir_ + "/same.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
+    std::ofstream(dir_ + "/bad.exr") << "v/1\x01 not an EXR";
+    std::ofstream(dir_ + "/bad.hdr") << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4000000 +X 4000000\n";
     // Not called views.tsv: that name beside ok.obj would give plain renders of ok.obj its view.
     std::ofstream(dir_ + "/tri-views.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\tnote\n"
                                            << "tri\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\tthe triangle\n";
@@ -93,7 +95,14 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render SAME", 1, "same.obj: all vertices coincide"},
       {"render --integrator foo", 2, "--integrator: unknown integrator 'foo'"},
       {"render --integrator path --spp 0", 2, "--spp: must be between 1 and 1048576, got 0"},
-      {"render --integrator whitted --env 1,1,1", 2, "--env: only for --integrator path"},
+      {"render --integrator ao --env 1,1,1", 2, "--env: only for --integrator path or whitted"},
+      {"render --integrator ao --env-map x.exr", 2, "--env-map: only for --integrator path or whitted"},
+      {"render --integrator path --env-map /nonexistent/sky.exr", 1, "/nonexistent/sky.exr: cannot open"},
+      {"render --integrator path --env-map BADEXR", 1, "bad.exr: cannot read EXR"},
+      {"render --integrator whitted --env-map BADHDR", 1,
+       "bad.hdr: environment map of 4000000 x 4000000 texels is larger"},
+      {"render --integrator path --env-map sky.txt", 1, "sky.txt: an environment map must be .exr or .hdr"},
+      {"render --integrator path --env-map x.exr --env-rotation nan", 2, "--env-rotation: expected a finite number"},
       {"render --integrator path --env 1,-1,1", 2, "--env: each component must be in [0, 1e30], got '1,-1,1'"},
       {"render --integrator path --env 1,1", 2, "--env: expected three numbers"},
       {"render --integrator path --light-sampling nee", 2, "--light-sampling: unknown light sampling 'nee'"},
@@ -119,6 +128,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
                                     {"RANGE", "range.obj"},
                                     {"EMPTY", "empty.obj"},
                                     {"SAME", "same.obj"},
+                                    {"BADEXR", "bad.exr"},
+                                    {"BADHDR", "bad.hdr"},
                                     {"BADVIEWS", "badviews.tsv"},
                                     {"VIEWS", "tri-views.tsv"}}) {
       for (size_t p = args.find(key); p != std::string::npos; p = args.find(key))
@@ -135,7 +146,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
   }
   // No temporary files were left behind either.
   for (const auto& entry : fs::directory_iterator(dir_)) {
-    EXPECT_TRUE(entry.path().extension() == ".obj" || entry.path().extension() == ".tsv") << entry.path();
+    const fs::path ext = entry.path().extension();
+    EXPECT_TRUE(ext == ".obj" || ext == ".tsv" || ext == ".exr" || ext == ".hdr") << entry.path();
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
+#include "io/environment_io.hpp"
 #include "io/image_io.hpp"
 #include "parallel/executor.hpp"
 #include "scene/builtin.hpp"
@@ -33,6 +34,10 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
   app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
   app.add_flag("--no-scene-lights", a.no_scene_lights, "drop the scene's emissive lights, keep only --light ones");
   app.add_option("--light-intensity", a.light_intensity, "point light intensity (default: (scene diagonal / 2)^2)");
+  app.add_option("--env-map", a.env_map,
+                 "path, whitted: light the scene from beyond with this equirectangular environment map (.exr or "
+                 ".hdr, linear radiance; times --env)");
+  app.add_option("--env-rotation", a.env_rotation, "degrees the --env-map turns about +y")->capture_default_str();
   app.add_option("--max-input-mib", a.max_input_mib, "largest OBJ file read, in MiB (1-1048576)")
       ->capture_default_str();
   app.add_option("--max-texture-mib", a.max_texture_mib,
@@ -60,8 +65,10 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--spp", a.spp,
                  "samples per pixel (1-1048576; default " + std::to_string(kDefaultPathSpp) +
                      " for path, 1 through the pixel centre for ao and whitted)");
-  app.add_option("--env", a.env,
-                 "path: radiance r,g,b of a uniform environment (default black; white when the scene has no light)");
+  app.add_option(
+      "--env", a.env,
+      "path, whitted: radiance r,g,b of a uniform environment, or the --env-map's scale (default black, 1,1,1 "
+      "with --env-map; white when the scene has no light)");
   app.add_option("--light-sampling", a.light_sampling,
                  "path: " + names_of<LightSampling>(kLightSamplingNames) +
                      " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
@@ -195,6 +202,12 @@ void add_lights(Scene& scene, const SceneArgs& a) {
   }
 }
 
+// --env-map: read once the scene is known good, so a bad scene is reported first.
+void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel) {
+  if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation: expected a finite number of degrees");
+  if (!a.env_map.empty()) scene.environment_map = load_environment_map(a.env_map, float(a.env_rotation), cancel);
+}
+
 }  // namespace
 
 Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* phases) {
@@ -221,6 +234,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     apply_view_light(scene, view);
     scene.camera = view.camera;
     add_lights(scene, a);
+    add_environment(scene, a, cancel);
     return scene;
   }
   Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
@@ -243,6 +257,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     }
   }
   add_lights(scene, a);
+  add_environment(scene, a, cancel);
   return scene;
 }
 
@@ -306,12 +321,17 @@ RenderSettings settings_for(const RenderArgs& a) {
   s.light_sampling =
       parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
   const bool path = s.integrator == Integrator::Path;
-  for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--checkpoint", a.checkpoint.has_value()}}) {
-    if (given && !path) throw UsageError(std::string(flag) + ": only for --integrator path");
+  if (a.checkpoint && !path) throw UsageError("--checkpoint: only for --integrator path");
+  for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--env-map", !a.scene.env_map.empty()}}) {
+    if (given && s.integrator == Integrator::Ao)
+      throw UsageError(std::string(flag) + ": only for --integrator path or whitted");
   }
   // Every integrator anti-aliases with --spp; ao and whitted take one centred sample by default.
   s.spp = a.spp.value_or(path ? kDefaultPathSpp : 1);
-  if (!a.env.empty()) s.environment = parse_vec3("--env", a.env);
+  if (!a.env.empty())
+    s.environment = parse_vec3("--env", a.env);
+  else if (!a.scene.env_map.empty())
+    s.environment = Vec3{1.0f};
   // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
   // not for whitted, whose rays go one at a time.
   const bool by_default = s.packets && !a.no_packets && a.simd != "off";
@@ -323,7 +343,7 @@ RenderSettings settings_for(const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
   RenderSettings s = settings_for(a);
   note.clear();
-  if (s.integrator == Integrator::Path && a.env.empty() && scene.emitters.empty()) {
+  if (s.integrator == Integrator::Path && a.env.empty() && scene.environment_map.empty() && scene.emitters.empty()) {
     s.environment = Vec3{1.0f};
     note = scene.source +
            " has no emissive surface: a uniform white sky lights it too (--env 1,1,1; --env 0,0,0 for none)";

@@ -27,6 +27,8 @@ struct SceneArgs {
   std::vector<std::string> lights;
   bool no_scene_lights = false;
   std::optional<double> light_intensity;
+  std::string env_map;        // an equirectangular .exr or .hdr lighting the scene from beyond
+  double env_rotation = 0.0;  // degrees about +y
   uint64_t max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the OBJ
   uint64_t max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
 };

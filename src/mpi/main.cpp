@@ -77,9 +77,10 @@ std::string settings_fingerprint(const Setup& s, const driver::RenderArgs& args)
     << name_of<Integrator>(kIntegratorNames, r.integrator) << "\n--spp " << r.spp << "\n--max-depth " << r.max_depth
     << "\n--ao " << r.ao_samples << "\n--ao-distance " << r.ao_distance << "\n--ambient " << r.ambient << "\n--seed "
     << r.seed << "\n--light-sampling " << name_of<LightSampling>(kLightSamplingNames, r.light_sampling) << "\n--env "
-    << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
-    << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--frames " << args.frames << "\n--orbit "
-    << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
+    << vec(r.environment) << "\n--env-map " << args.scene.env_map << "\n--env-rotation " << args.scene.env_rotation
+    << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up " << vec(s.camera.up)
+    << "\n--fov " << s.camera.fov_degrees << "\n--frames " << args.frames << "\n--orbit " << args.orbit
+    << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
     << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block
     << "\n";
   return f.str();

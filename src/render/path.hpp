@@ -1,39 +1,57 @@
-// Unbiased path tracing. At each non-specular vertex: next-event estimation toward one emissive
-// triangle (chosen by power, a point by area) and toward every point light, then a BSDF sample
-// continues the path; an emitter the path hits is weighted against the light sample that could
-// have found it by the power heuristic (Veach's MIS). Russian roulette from the fourth bounce.
-// Every random number is a function of (pixel, sample, bounce), so the image does not depend on
+// Unbiased path tracing. At each non-specular vertex: next-event estimation toward one light --
+// the environment (its map by luminance, a uniform sky cosine-weighted) or one emissive triangle
+// (chosen by power, a point by area) -- and toward every point light, then a BSDF sample
+// continues the path; a light the path hits (an emitter, or the environment when a ray escapes)
+// is weighted against the light sample that could have found it by the power heuristic (Veach's
+// MIS). Russian roulette from the fourth bounce. The samples are stratified (Sobol-Burley, see
+// math/sobol.hpp), a function of (pixel, sample, bounce), so the image does not depend on
 // threads, tiles, passes or the accelerator.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
 
-#include "math/rng.hpp"
+#include "math/sobol.hpp"
 #include "parallel/tiles.hpp"
 #include "render/accel_concepts.hpp"
+#include "render/environment_light.hpp"
 #include "render/surface_point.hpp"
 #include "shade/material_bsdf.hpp"
 
 namespace tracer {
 
-// Random dimensions: 0 and 1 place the sample in the pixel; each bounce then takes kPathDims:
-// three for the emitter sample, three for the BSDF sample, one for Russian roulette.
-inline constexpr uint32_t kPathPixelDims = 2, kPathDims = 7;
+// Sample dimensions, in sets (PixelSampler::get): set 0 places the sample in the pixel (x, y);
+// bounce b takes set 1 + 3b (the light's choice and two for the point on it), set 2 + 3b (the
+// BSDF's lobe and two for the direction) and set 3 + 3b (Russian roulette).
+inline constexpr uint32_t kPixelSet = 0;
+constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
+constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
+constexpr uint32_t roulette_set(int depth) { return 3 + 3 * uint32_t(depth); }
 inline constexpr int kRouletteDepth = 3;  // bounces kept unconditionally
 
 template <class Accel>
-Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const SampleRng& rng, RayCounts& counts) {
+Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PixelSampler& sampler,
+                   RayCounts& counts) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
+  const EnvironmentLight env = EnvironmentLight::of(ctx);
   const bool nee = s.light_sampling == LightSampling::Mis;
+  // A light sample picks the environment with this probability, else an emitter.
+  const float p_env = env.black() ? 0.0f : scene.emitters.empty() ? 1.0f : 0.5f;
   Vec3 radiance{0.0f}, beta{1.0f};
-  bool specular = true;  // the last bounce was a delta lobe (or the camera): no light sample competed
+  // No light sample could have found what this ray finds: the last bounce was a delta lobe (or
+  // this is the camera ray), or it went through the surface, where light samples never go.
+  bool unsampled = true;
   float bsdf_pdf = 0.0f;
+  Vec3 prev_n{0.0f};  // the geometric normal at the vertex the ray left, on its side
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!accel.intersect(ray, hit)) {
-      radiance += beta * s.environment;
+      if (p_env > 0.0f) {
+        float w = 1.0f;
+        if (nee && !unsampled) w = power_heuristic(bsdf_pdf, p_env * env.pdf(prev_n, ray.dir));
+        radiance += beta * env.radiance(ray.dir) * w;
+      }
       break;
     }
     SurfacePoint sp = surface_point(ctx, ray, hit);
@@ -41,28 +59,45 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     const Material& mat = *sp.mat;
     if (mat.emissive() && sp.front) {  // emitters shine from their front face (see Emitters)
       float w = 1.0f;
-      if (nee && !specular) w = power_heuristic(bsdf_pdf, scene.emitters.pdf(scene, hit.tri, ray.org, sp.position));
+      if (nee && !unsampled) {
+        w = power_heuristic(bsdf_pdf, (1.0f - p_env) * scene.emitters.pdf(scene, hit.tri, ray.org, sp.position));
+      }
       radiance += beta * mat.ke * w;
     }
     if (depth >= s.max_depth) break;
-    const uint32_t dim = kPathPixelDims + uint32_t(depth) * kPathDims;
     const Bsdf bsdf = material_bsdf(mat, diffuse_color(scene, hit, mat), sp.shading_n, sp.front);
     const Vec3 wo = -ray.dir;
     if (!bsdf.delta()) {
-      // One emitter sample: Ke * f * cos / pdf, weighted against BSDF sampling.
-      EmitterSample es;
-      if (nee && scene.emitters.sample(scene, sp.origin, rng.draw(dim), rng.draw(dim + 1), rng.draw(dim + 2), es) &&
-          dot(es.wi, sp.n) > 0.0f) {
-        const Vec3 f = bsdf.eval(wo, es.wi);
-        if (max_component(f) > 0.0f) {
+      const std::array<float, 3> lu = sampler.get<3>(light_set(depth));
+      // One light sample: L * f * cos / pdf, weighted against BSDF sampling.
+      Vec3 wi, emitted{0.0f};
+      float light_pdf = 0.0f, distance = kInfinity;
+      if (nee && lu[0] < p_env) {
+        if (env.sample(sp.n, lu[1], lu[2], wi, light_pdf)) {
+          light_pdf *= p_env;
+          emitted = env.radiance(wi);
+        }
+      } else if (nee) {
+        EmitterSample es;
+        const float u_select = (lu[0] - p_env) / (1.0f - p_env);
+        if (scene.emitters.sample(scene, sp.origin, std::min(u_select, 0x1.fffffep-1f), lu[1], lu[2], es)) {
+          wi = es.wi;
+          light_pdf = es.pdf * (1.0f - p_env);
+          emitted = es.radiance;
+          distance = es.distance * (1.0f - 1e-4f);  // stop short of the emitter's own surface
+        }
+      }
+      if (light_pdf > 0.0f && dot(wi, sp.n) > 0.0f) {
+        const Vec3 f = bsdf.eval(wo, wi);
+        if (max_component(f * emitted) > 0.0f) {
           Ray shadow;
           shadow.org = sp.origin;
-          shadow.dir = es.wi;
-          shadow.tfar = es.distance * (1.0f - 1e-4f);  // stop short of the emitter's own surface
+          shadow.dir = wi;
+          shadow.tfar = distance;
           ++counts.shadow;
           if (!occluded_leaving(accel, shadow, sp.tri)) {
-            const float w = power_heuristic(es.pdf, bsdf.pdf(wo, es.wi));
-            radiance += beta * f * es.radiance * (w / es.pdf);
+            const float w = power_heuristic(light_pdf, bsdf.pdf(wo, wi));
+            radiance += beta * f * emitted * (w / light_pdf);
           }
         }
       }
@@ -73,29 +108,31 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
         const float d2 = dot(to, to);
         if (!(d2 > 0.0f)) continue;
         const float d = std::sqrt(d2);
-        const Vec3 wi = to / d;
-        if (dot(wi, sp.n) <= 0.0f) continue;
-        const Vec3 f = bsdf.eval(wo, wi);
+        const Vec3 to_light = to / d;
+        if (dot(to_light, sp.n) <= 0.0f) continue;
+        const Vec3 f = bsdf.eval(wo, to_light);
         if (!(max_component(f) > 0.0f)) continue;
         Ray shadow;
         shadow.org = sp.origin;
-        shadow.dir = wi;
+        shadow.dir = to_light;
         shadow.tfar = d;
         ++counts.shadow;
         if (!occluded_leaving(accel, shadow, sp.tri)) radiance += beta * f * light.power / d2;
       }
     }
+    const std::array<float, 3> bu = sampler.get<3>(bsdf_set(depth));
     BsdfSample bs;
-    if (!bsdf.sample(wo, rng.draw(dim + 3), rng.draw(dim + 4), rng.draw(dim + 5), bs)) break;
+    if (!bsdf.sample(wo, bu[0], bu[1], bu[2], bs)) break;
     // The shading normal may send a reflection through the geometric surface (or a refraction
     // back out): such a sample has no consistent meaning, so the path ends.
     if ((dot(bs.wi, sp.n) < 0.0f) != bs.transmitted) break;
     beta = beta * bs.weight;
-    specular = bs.delta;
+    unsampled = bs.delta || bs.transmitted;
     bsdf_pdf = bs.pdf;
+    prev_n = sp.n;
     if (depth >= kRouletteDepth) {
       const float keep = std::min(0.95f, max_component(beta));
-      if (!(rng.draw(dim + 6) < keep)) break;
+      if (!(sampler.get<1>(roulette_set(depth))[0] < keep)) break;
       beta = beta / keep;
     }
     ray = Ray{};
@@ -117,10 +154,11 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
       const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
       Vec3 sum{0.0f};
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
-        const SampleRng rng(pixel, k, s.seed);
-        const Ray ray = ctx.camera.ray_through(float(x) + rng.draw(0), float(y) + rng.draw(1));
+        const PixelSampler sampler(pixel, k, s.seed);
+        const std::array<float, 2> pu = sampler.get<2>(kPixelSet);
+        const Ray ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1]);
         ++counts.primary;
-        const Vec3 l = path_radiance(accel, ctx, ray, rng, counts);
+        const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts);
         if (is_finite(l)) sum += l;
       }
       ctx.framebuffer->add(x, y, sum, ctx.samples.count);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "render/ao.hpp"
+#include "render/environment_light.hpp"
 #include "shade/optics.hpp"
 
 namespace tracer {
@@ -10,11 +11,12 @@ namespace tracer {
 // Whitted ray tracing along `ray`, `depth` specular bounces from the camera: what the surface it
 // hits emits, plus its direct light and ambient term where diffuse, its mirror image where a
 // mirror, and where a dielectric the Fresnel-weighted reflected and (filtered by Tf) refracted
-// images, with total internal reflection; nothing past max_depth bounces or when nothing is hit.
+// images, with total internal reflection; nothing past max_depth bounces; the environment (--env,
+// --env-map) where nothing is hit. Diffuse surfaces take their light from the lights only.
 template <class Accel>
 Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& ray, int depth, RayCounts& counts) {
   Hit hit;
-  if (!accel.intersect(ray, hit)) return Vec3{0.0f};
+  if (!accel.intersect(ray, hit)) return EnvironmentLight::of(ctx).radiance(ray.dir);
   SurfacePoint sp = surface_point(ctx, ray, hit);  // sp.n faces the ray's side
   sp.shading_n = interpolated_normal(*ctx.scene, hit, sp.n);
   const Material& mat = *sp.mat;

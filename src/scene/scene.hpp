@@ -12,6 +12,7 @@
 #include "math/aabb.hpp"
 #include "math/vec.hpp"
 #include "scene/emitters.hpp"
+#include "scene/environment_map.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -100,7 +101,8 @@ struct Scene {
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
   std::vector<Light> lights;
-  Emitters emitters;  // the emissive triangles, for the path integrator's light sampling
+  Emitters emitters;               // the emissive triangles, for the path integrator's light sampling
+  EnvironmentMap environment_map;  // --env-map: the light from beyond the scene, or empty
   size_t vertex_count = 0;
   size_t degenerate_count = 0;
   Aabb bounds;
