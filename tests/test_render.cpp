@@ -161,6 +161,37 @@ TEST(Render, PathAndWhittedReferenceImages) {
   expect_golden("", sponza + " --integrator whitted" + scalar, "whitted-Sponza", 40.0);
 }
 
+TEST(Render, AovLayersHoldTheFirstHitsAlbedoAndNormal) {
+  // --aov albedo,normal: beside the radiance, the mean over each pixel's samples of the first
+  // hit's albedo and shading normal. Inside the Cornell box a pixel wholly on the left wall holds
+  // its Kd and the normal facing +x; one on the back wall the floor's Kd and +z. The radiance is the render's without
+  // the layers, to the byte.
+  if (!test::have_shared_scenes()) GTEST_SKIP() << "no ../shared/scenes";
+  const std::string dir = test::temp_dir();
+  const std::string common = cornell("Original") + " --integrator path --spp 4 --width 32 --height 32 -q --exr float";
+  ASSERT_EQ(test::run_tracer("render " + common + " --aov albedo,normal -o " + dir + "/a.exr").exit_code, 0);
+  ASSERT_EQ(test::run_tracer("render " + common + " -o " + dir + "/b.exr").exit_code, 0);
+  const Framebuffer albedo = read_exr(dir + "/a.exr", {"albedo", nullptr, {"R", "G", "B"}});
+  const Framebuffer normal = read_exr(dir + "/a.exr", {"normal", nullptr, {"X", "Y", "Z"}});
+  const Framebuffer with = read_exr(dir + "/a.exr"), without = read_exr(dir + "/b.exr");
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) ASSERT_EQ(with.radiance(x, y), without.radiance(x, y)) << x << "," << y;
+  // Pixel (5, 16): the left wall; (16, 12): the back wall, between the boxes and the lamp.
+  const Vec3 left = albedo.radiance(5, 16), back = albedo.radiance(16, 12);
+  EXPECT_NEAR(left.x, 0.63f, 1e-6f);
+  EXPECT_NEAR(left.y, 0.065f, 1e-6f);
+  EXPECT_NEAR(back.x, 0.725f, 1e-6f);
+  EXPECT_NEAR(normal.radiance(5, 16).x, 1.0f, 1e-3f);  // the walls of this file lean a little
+  EXPECT_NEAR(normal.radiance(16, 12).z, 1.0f, 1e-3f);
+  // Asked for where they cannot be written: one-line usage errors.
+  const auto png = test::run_tracer("render " + common + " --aov albedo -o " + dir + "/c.png");
+  EXPECT_EQ(png.exit_code, 2);
+  EXPECT_NE(png.output.find("--aov: the layers need an .exr output (-o)"), std::string::npos) << png.output;
+  const auto bad = test::run_tracer("render " + common + " --aov depth -o " + dir + "/c.exr");
+  EXPECT_NE(bad.output.find("--aov: unknown layer 'depth' (expected albedo, normal)"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Exr, LinearRadianceRoundTripsAsFloatAndAsHalf) {
   // Values a render holds: zero, tiny, ordinary, above 1, large, in a 5x3 image (rows and
   // columns distinguishable). Float round-trips exactly; half within its 11-bit precision.

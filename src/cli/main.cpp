@@ -71,8 +71,8 @@ int cmd_render(const RenderArgs& args) {
     }
     return true;
   };
-  const FrameSequence frames{args.output,     args.frames,         args.orbit,
-                             args.checkpoint, exr_pixel_for(args), args.save_partial};
+  const FrameSequence frames{args.output,         args.frames,       args.orbit,    args.checkpoint,
+                             exr_pixel_for(args), args.save_partial, aovs_for(args)};
   const DriveResult r = drive_render(scene, camera, settings, frames, true, true, cancel, render_round,
                                      [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
   if (r.stopped) {

@@ -69,6 +69,9 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
       "--env", a.env,
       "path, whitted: radiance r,g,b of a uniform environment, or the --env-map's scale (default black, 1,1,1 "
       "with --env-map; white when the scene has no light)");
+  app.add_option("--aov", a.aov,
+                 "path: also write these layers of the first hit into the .exr output, for a denoiser: albedo, "
+                 "normal (comma-separated)");
   app.add_option("--light-sampling", a.light_sampling,
                  "path: " + names_of<LightSampling>(kLightSamplingNames) +
                      " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
@@ -158,6 +161,7 @@ void validate(const RenderArgs& a) {
   simd_target_for(a);
   settings_for(a);
   exr_pixel_for(a);
+  aovs_for(a);
 }
 
 bool same_file(const std::string& a, const std::string& b) {
@@ -363,6 +367,25 @@ std::string black_image_warning(const RenderSettings& s, const Scene& scene) {
   }
   return "the image is black: " + why +
          "; --integrator path --env 1,1,1 lights it with a white sky, --light x,y,z adds a point light";
+}
+
+Aovs aovs_for(const RenderArgs& a) {
+  Aovs aovs;
+  if (a.aov.empty()) return aovs;
+  for (const std::string& name : split_list("--aov", a.aov)) {
+    if (name == "albedo") {
+      aovs.albedo = true;
+    } else if (name == "normal") {
+      aovs.normal = true;
+    } else {
+      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal)");
+    }
+  }
+  if (a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {
+    throw UsageError("--aov: only for --integrator path");
+  }
+  if (image_format_for(a.output) != ImageFormat::Exr) throw UsageError("--aov: the layers need an .exr output (-o)");
+  return aovs;
 }
 
 AccelOptions accel_options_for(const RenderArgs& a) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "driver/render_driver.hpp"
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
@@ -57,6 +58,7 @@ struct RenderArgs {
   std::string light_sampling{name_of<LightSampling>(kLightSamplingNames, RenderSettings{}.light_sampling)};
   std::optional<int> spp;            // path: samples per pixel (default kDefaultPathSpp)
   std::string env;                   // path: uniform environment radiance r,g,b
+  std::string aov;                   // path: albedo,normal layers in the EXR
   std::optional<double> checkpoint;  // path: seconds between rewrites of the output
   int frames = 1;                    // --frames: an image sequence, the camera orbiting
   double orbit = 0.0;                // --orbit: degrees the camera turns over the whole sequence
@@ -98,6 +100,8 @@ AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);
 ExrPixel exr_pixel_for(const RenderArgs& args);
+// --aov: a comma-separated list of albedo and normal, only for path renders to .exr; throws UsageError.
+Aovs aovs_for(const RenderArgs& args);
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);
 

@@ -24,11 +24,18 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
   bool warned_black = false;
   for (int frame = 0; frame < seq.frames; ++frame) {
     const std::string output = frame_output(seq.output, frame, seq.frames);
-    std::optional<Framebuffer> fb;
+    std::optional<Framebuffer> fb, albedo, normal;
     if (holds_image) fb.emplace(settings.width, settings.height);
+    if (holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
+    if (holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
     const Camera cam(frame_camera(camera, frame, seq.frames, seq.orbit_degrees), settings.width, settings.height);
-    const RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
-    const auto write = [&] { write_render(output, *fb, settings.exposure, seq.exr); };
+    RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
+    ctx.albedo = albedo ? &*albedo : nullptr;
+    ctx.normal = normal ? &*normal : nullptr;
+    std::vector<ExrLayer> layers;
+    if (albedo) layers.push_back({"albedo", &*albedo, {"R", "G", "B"}});
+    if (normal) layers.push_back({"normal", &*normal, {"X", "Y", "Z"}});
+    const auto write = [&] { write_render(output, *fb, settings.exposure, seq.exr, layers); };
     auto last_write = Clock::now();
     uint32_t done = 0;
     for (const std::vector<SampleRange>& round : rounds_of(settings, round_per_pass)) {

@@ -17,6 +17,12 @@
 
 namespace tracer::driver {
 
+// The --aov layers: first-hit albedo and shading normal, for a denoiser.
+struct Aovs {
+  bool albedo = false, normal = false;
+  bool any() const { return albedo || normal; }
+};
+
 struct FrameSequence {
   std::string output;  // one frame: this name; N frames: NAME-0000.EXT ... (frame_output)
   int frames = 1;
@@ -24,6 +30,7 @@ struct FrameSequence {
   std::optional<double> checkpoint_seconds;  // rewrite the output this often while passes add up
   ExrPixel exr = ExrPixel::Half;
   bool save_partial = false;  // on a stop, write finished tiles of a frame with no complete pass
+  Aovs aovs;                  // --aov: layers written into the EXR beside the radiance
 };
 
 // Renders the passes of `round` of the frame `ctx` describes into ctx.framebuffer (null on a rank

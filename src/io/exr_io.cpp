@@ -38,13 +38,14 @@ class MemoryStream : public Imf::OStream {
 
 template <class T>
 void add_channels(Imf::Header& header, Imf::FrameBuffer& frame, std::vector<T>& planes, int w, int h,
-                  Imf::PixelType type) {
+                  Imf::PixelType type, const std::string& prefix = "",
+                  const std::array<const char*, 3>& names = {"R", "G", "B"}) {
   const size_t n = size_t(w) * size_t(h);
-  const char* names[3] = {"R", "G", "B"};
   for (int c = 0; c < 3; ++c) {
-    header.channels().insert(names[c], Imf::Channel(type));
-    frame.insert(names[c], Imf::Slice(type, reinterpret_cast<char*>(planes.data() + size_t(c) * n), sizeof(T),
-                                      sizeof(T) * size_t(w)));
+    const std::string name = prefix.empty() ? std::string(names[c]) : prefix + "." + names[c];
+    header.channels().insert(name, Imf::Channel(type));
+    frame.insert(name, Imf::Slice(type, reinterpret_cast<char*>(planes.data() + size_t(c) * n), sizeof(T),
+                                  sizeof(T) * size_t(w)));
   }
 }
 
@@ -66,19 +67,26 @@ std::vector<T> planar(const Framebuffer& fb) {
 
 }  // namespace
 
-std::string encode_exr(const Framebuffer& fb, ExrPixel pixel) {
+std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers) {
   try {
     Imf::Header header(fb.width(), fb.height());
     header.compression() = Imf::ZIP_COMPRESSION;
     Imf::FrameBuffer frame;
-    std::vector<half> halves;
-    std::vector<float> floats;
-    if (pixel == ExrPixel::Half) {
-      halves = planar<half>(fb);
-      add_channels(header, frame, halves, fb.width(), fb.height(), Imf::HALF);
-    } else {
-      floats = planar<float>(fb);
-      add_channels(header, frame, floats, fb.width(), fb.height(), Imf::FLOAT);
+    // One set of planes per layer, kept alive until the pixels are written.
+    std::vector<std::vector<half>> halves(1 + layers.size());
+    std::vector<std::vector<float>> floats(1 + layers.size());
+    for (size_t l = 0; l <= layers.size(); ++l) {
+      const Framebuffer& image = l == 0 ? fb : *layers[l - 1].image;
+      const std::string prefix = l == 0 ? "" : layers[l - 1].name;
+      const std::array<const char*, 3> names =
+          l == 0 ? std::array<const char*, 3>{"R", "G", "B"} : layers[l - 1].channels;
+      if (pixel == ExrPixel::Half) {
+        halves[l] = planar<half>(image);
+        add_channels(header, frame, halves[l], fb.width(), fb.height(), Imf::HALF, prefix, names);
+      } else {
+        floats[l] = planar<float>(image);
+        add_channels(header, frame, floats[l], fb.width(), fb.height(), Imf::FLOAT, prefix, names);
+      }
     }
     MemoryStream stream;
     {
@@ -92,18 +100,19 @@ std::string encode_exr(const Framebuffer& fb, ExrPixel pixel) {
   }
 }
 
-Framebuffer read_exr(const std::string& path) {
+Framebuffer read_exr(const std::string& path, const ExrLayer& layer) {
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
     const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
     std::vector<float> planes(3 * size_t(w) * size_t(h));
     Imf::FrameBuffer frame;
-    const char* names[3] = {"R", "G", "B"};
     for (int c = 0; c < 3; ++c) {
+      const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
+      if (!file.header().channels().findChannel(name)) throw InputError(path + ": no channel " + name);
       char* base = reinterpret_cast<char*>(planes.data() + size_t(c) * size_t(w) * size_t(h));
       base -= (size_t(window.min.x) + size_t(window.min.y) * size_t(w)) * sizeof(float);
-      frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+      frame.insert(name, Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
@@ -116,6 +125,8 @@ Framebuffer read_exr(const std::string& path) {
       }
     }
     return fb;
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& e) {
     throw InputError(path + ": cannot read EXR: " + e.what());
   }

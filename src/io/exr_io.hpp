@@ -1,7 +1,9 @@
 // OpenEXR output: the framebuffer's linear radiance, no tone mapping, as half or float RGB.
 #pragma once
 
+#include <array>
 #include <string>
+#include <vector>
 
 #include "base/enum_names.hpp"
 #include "film/framebuffer.hpp"
@@ -11,10 +13,20 @@ namespace tracer {
 enum class ExrPixel { Half, Float };
 inline constexpr EnumName<ExrPixel> kExrPixelNames[] = {{ExrPixel::Half, "half"}, {ExrPixel::Float, "float"}};
 
-// The bytes of an EXR file holding `fb` (channels R, G, B, ZIP compression); throws InputError.
-std::string encode_exr(const Framebuffer& fb, ExrPixel pixel);
+// A further layer of an EXR beside the radiance (an AOV for a denoiser): channels NAME.C for the
+// three channel names given.
+struct ExrLayer {
+  std::string name;
+  const Framebuffer* image = nullptr;
+  std::array<const char*, 3> channels{"R", "G", "B"};
+};
 
-// Reads an EXR's R, G, B channels as floats (tests, image comparison); throws InputError.
-Framebuffer read_exr(const std::string& path);
+// The bytes of an EXR file holding `fb` (channels R, G, B, ZIP compression) and `layers`, all
+// of `pixel` type; throws InputError.
+std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers = {});
+
+// Reads an EXR's R, G, B channels as floats (tests, image comparison), or those of a layer
+// (NAME.R ... as encode_exr writes them); throws InputError.
+Framebuffer read_exr(const std::string& path, const ExrLayer& layer = {});
 
 }  // namespace tracer

@@ -201,9 +201,10 @@ void remove_pending_temp_file() {
   if (g_pending.load()) ::unlink(g_pending_temp);
 }
 
-void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel) {
+void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel,
+                  const std::vector<ExrLayer>& layers) {
   if (image_format_for(path) == ImageFormat::Exr) {
-    write_file_atomic(path, encode_exr(fb, exr_pixel));
+    write_file_atomic(path, encode_exr(fb, exr_pixel, layers));
   } else {
     write_image(path, tonemap(fb, exposure));
   }

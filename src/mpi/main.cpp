@@ -100,6 +100,7 @@ Setup set_up(const driver::RenderArgs& args, const MpiSession& session) {
   Setup s;
   try {
     driver::validate(args);
+    if (!args.aov.empty()) throw UsageError("--aov: not for tracer-mpi yet (tracer render writes the layers)");
     if (session.root()) driver::check_outputs(args);
     WideBvh::force_simd_target(driver::simd_target_for(args));
     const auto t0 = Clock::now();

@@ -29,9 +29,16 @@ constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
 constexpr uint32_t roulette_set(int depth) { return 3 + 3 * uint32_t(depth); }
 inline constexpr int kRouletteDepth = 3;  // bounces kept unconditionally
 
+// What the camera ray hits first, for the --aov layers: its albedo (the diffuse colour, plus the
+// specular colour of glossy materials, 1 for mirrors and glass, as Intel's denoiser takes it) and
+// its shading normal; both zero where the ray escapes.
+struct FirstHit {
+  Vec3 albedo{0.0f}, normal{0.0f};
+};
+
 template <class Accel>
 Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PixelSampler& sampler,
-                   RayCounts& counts) {
+                   RayCounts& counts, FirstHit* first = nullptr) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
   const EnvironmentLight env = EnvironmentLight::of(ctx);
@@ -65,8 +72,14 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
       radiance += beta * mat.ke * w;
     }
     if (depth >= s.max_depth) break;
-    const Bsdf bsdf = material_bsdf(mat, diffuse_color(scene, hit, mat), sp.shading_n, sp.front);
+    const Vec3 kd = diffuse_color(scene, hit, mat);
+    const Bsdf bsdf = material_bsdf(mat, kd, sp.shading_n, sp.front);
     const Vec3 wo = -ray.dir;
+    if (depth == 0 && first) {
+      const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
+      first->albedo = Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
+      first->normal = sp.shading_n;
+    }
     if (!bsdf.delta()) {
       const std::array<float, 3> lu = sampler.get<3>(light_set(depth));
       // One light sample: L * f * cos / pdf, weighted against BSDF sampling.
@@ -152,16 +165,22 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
   for (int y = tile.y0; y < tile.y1; ++y) {
     for (int x = tile.x0; x < tile.x1; ++x) {
       const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
-      Vec3 sum{0.0f};
+      Vec3 sum{0.0f}, albedo{0.0f}, normal{0.0f};
+      const bool aovs = ctx.albedo || ctx.normal;
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const PixelSampler sampler(pixel, k, s.seed);
         const std::array<float, 2> pu = sampler.get<2>(kPixelSet);
         const Ray ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1]);
         ++counts.primary;
-        const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts);
+        FirstHit first;
+        const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr);
         if (is_finite(l)) sum += l;
+        albedo += first.albedo;
+        normal += first.normal;
       }
       ctx.framebuffer->add(x, y, sum, ctx.samples.count);
+      if (ctx.albedo) ctx.albedo->add(x, y, albedo, ctx.samples.count);
+      if (ctx.normal) ctx.normal->add(x, y, normal, ctx.samples.count);
     }
   }
 }

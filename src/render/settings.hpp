@@ -81,6 +81,10 @@ struct RenderContext {
   RenderSettings settings;
   Framebuffer* framebuffer = nullptr;
   SampleRange samples;  // path: this pass's samples (ao and whitted take one, at the pixel centre)
+  // path, --aov: where each sample's first hit adds its albedo and shading normal (for a
+  // denoiser), summed and counted as the radiance is; null when not asked for.
+  Framebuffer* albedo = nullptr;
+  Framebuffer* normal = nullptr;
 };
 
 }  // namespace tracer

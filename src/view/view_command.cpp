@@ -28,6 +28,7 @@ int run_view(ViewArgs args) {
   // The render flags that make files or sequences mean nothing here (save downloads the image).
   if (r.frames != 1) throw UsageError("--frames: not for tracer view (an image sequence is tracer render's)");
   if (r.orbit != 0.0) throw UsageError("--orbit: not for tracer view (drag to orbit)");
+  if (!r.aov.empty()) throw UsageError("--aov: not for tracer view (tracer render writes the layers)");
   if (r.checkpoint) throw UsageError("--checkpoint: not for tracer view (save downloads the image)");
   check_range("--width", r.settings.width, 1, kMaxViewSide);
   check_range("--height", r.settings.height, 1, kMaxViewSide);
