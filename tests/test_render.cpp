@@ -1,6 +1,8 @@
 // Images: an analytic Lambert answer, golden images of the study's scenes, determinism.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -189,6 +191,60 @@ TEST(Render, AovLayersHoldTheFirstHitsAlbedoAndNormal) {
   EXPECT_NE(png.output.find("--aov: the layers need an .exr output (-o)"), std::string::npos) << png.output;
   const auto bad = test::run_tracer("render " + common + " --aov depth -o " + dir + "/c.exr");
   EXPECT_NE(bad.output.find("--aov: unknown layer 'depth' (expected albedo, normal)"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Render, BumpMapOfConstantGradientShadesAsTheTiltedPlane) {
+  // A 2 x 2 square in z = 0 with texture coordinates (x/2, y/2), its bump map a ramp: column i of
+  // 256 holds the byte i, so height = u * 256/255 and the surface displaced by -bm 0.5 is the
+  // plane z = 0.5 * 256/255 * x/2, whose normal is (-g, 0, 1) / |..| with g = 64/255. Seen from
+  // above, the shading normal (--aov normal) is that normal wherever the central differences
+  // stay inside the ramp (away from u = 0 and 1, where it wraps). Without the map: +z.
+  const std::string dir = test::temp_dir();
+  Image8 ramp;
+  ramp.width = 256;
+  ramp.height = 4;
+  ramp.rgb.resize(size_t(256) * 4 * 3);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 256; ++x)
+      for (int c = 0; c < 3; ++c) ramp.rgb[(size_t(y) * 256 + size_t(x)) * 3 + size_t(c)] = uint8_t(x);
+  write_image(dir + "/ramp.png", ramp);
+  std::ofstream(dir + "/plane.mtl") << "newmtl bumpy\nKd 0.5 0.5 0.5\nmap_bump -bm 0.5 ramp.png\n"
+                                    << "newmtl flat\nKd 0.5 0.5 0.5\n";
+  for (const char* mat : {"bumpy", "flat"}) {
+    std::ofstream(dir + "/plane.obj") << "mtllib plane.mtl\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\n"
+                                      << "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl " << mat << "\nf 1/1 2/2 3/3 4/4\n";
+    const auto r = test::run_tracer("render " + dir +
+                                    "/plane.obj --eye 1,1,5 --look 1,1,0 --fov 20 --width 32 "
+                                    "--height 32 --spp 1 --env 1,1,1 --aov normal --exr float -q -o " +
+                                    dir + "/n.exr");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const Framebuffer n = read_exr(dir + "/n.exr", {"normal", nullptr, {"X", "Y", "Z"}});
+    const float g = std::string(mat) == "bumpy" ? 64.0f / 255.0f : 0.0f;
+    const float len = std::sqrt(1.0f + g * g);
+    for (int y = 8; y < 24; ++y)
+      for (int x = 8; x < 24; ++x) {
+        const Vec3 v = n.radiance(x, y);
+        EXPECT_NEAR(v.x, -g / len, 2e-3f) << mat << " " << x << "," << y;
+        EXPECT_NEAR(v.y, 0.0f, 2e-3f) << mat << " " << x << "," << y;
+        EXPECT_NEAR(v.z, 1.0f / len, 2e-3f) << mat << " " << x << "," << y;
+      }
+  }
+  // No black fringes: bumps far steeper than the view (-bm 40, seen at 80 degrees from the
+  // normal) under a white sky leave no pixel of the plane black, for path and whitted.
+  std::ofstream(dir + "/plane.mtl") << "newmtl bumpy\nKd 0.5 0.5 0.5\nmap_bump -bm 40 ramp.png\n";
+  std::ofstream(dir + "/plane.obj") << "mtllib plane.mtl\nv -50 -50 0\nv 50 -50 0\nv 50 50 0\nv -50 50 0\n"
+                                    << "vt 0 0\nvt 9 0\nvt 9 9\nvt 0 9\nusemtl bumpy\nf 1/1 2/2 3/3 4/4\n";
+  for (const char* integrator : {"path --env 1,1,1", "whitted --light 0,0,30"}) {
+    const auto r = test::run_tracer("render " + dir +
+                                    "/plane.obj --eye 0,-20,3.5 --look 0,0,0 --fov 30 --width 24 "
+                                    "--height 24 --spp 4 --exr float -q -o " +
+                                    dir + "/g.exr --integrator " + integrator);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const Framebuffer img = read_exr(dir + "/g.exr");
+    for (int y = 14; y < 24; ++y)  // the lower part of the image: the plane
+      for (int x = 0; x < 24; ++x) EXPECT_GT(luminance(img.radiance(x, y)), 0.0f) << integrator << " " << x << "," << y;
+  }
   std::filesystem::remove_all(dir);
 }
 

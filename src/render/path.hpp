@@ -64,6 +64,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     SurfacePoint sp = surface_point(ctx, ray, hit);
     sp.shading_n = interpolated_normal(scene, hit, sp.n);
     const Material& mat = *sp.mat;
+    sp.shading_n = bumped_normal(scene, hit, mat, sp.shading_n, -ray.dir);
     if (mat.emissive() && sp.front) {  // emitters shine from their front face (see Emitters)
       float w = 1.0f;
       if (nee && !unsampled) {

@@ -59,6 +59,37 @@ inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
   return dot(unit, n) < 0.0f ? -unit : unit;
 }
 
+// The shading normal `ns` moved by the material's bump map, as pbrt's bump mapping does: the
+// surface displaced along ns by bump_multiplier * height(u, v) in scene units, whose tangents are
+// dp/du + ns dh/du and dp/dv + ns dh/dv (dp/du, dp/dv from the triangle's positions and texture
+// coordinates; dh/du, dh/dv by central differences one texel wide), the normal their cross
+// product on ns's side. A normal that would face away from the viewer `wo` (where the BSDF would
+// return black: the fringes of shading normals) is tilted back until it faces it, just.
+inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& mat, Vec3 ns, Vec3 wo) {
+  if (mat.bump_texture == kInvalidIndex || scene.corner_uvs.empty()) return ns;
+  const Triangle& tri = scene.triangles[hit.tri];
+  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
+  const float du1 = c[1].x - c[0].x, dv1 = c[1].y - c[0].y, du2 = c[2].x - c[0].x, dv2 = c[2].y - c[0].y;
+  const float det = du1 * dv2 - dv1 * du2;
+  if (!(std::fabs(det) > 1e-20f)) return ns;  // degenerate texture coordinates: no tangents
+  const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+  const Vec3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0f / det), dpdv = (e2 * du1 - e1 * du2) * (1.0f / det);
+  const Texture& t = scene.textures[mat.bump_texture];
+  const float w = 1.0f - hit.u - hit.v;
+  const float u = c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, v = c[0].y * w + c[1].y * hit.u + c[2].y * hit.v;
+  const float hu = 0.5f / float(t.width()), hv = 0.5f / float(t.height());
+  const float dhdu = (t.height(u + hu, v) - t.height(u - hu, v)) / (2.0f * hu) * mat.bump_multiplier;
+  const float dhdv = (t.height(u, v + hv) - t.height(u, v - hv)) / (2.0f * hv) * mat.bump_multiplier;
+  Vec3 n = cross(dpdu + ns * dhdu, dpdv + ns * dhdv);
+  const float len = length(n);
+  if (!(len > 0.0f) || !std::isfinite(len)) return ns;
+  n = n / len;
+  if (dot(n, ns) < 0.0f) n = -n;
+  constexpr float kMinCos = 0.01f;
+  if (const float cos_o = dot(n, wo); cos_o < kMinCos) n = normalize(n + wo * (kMinCos - cos_o));
+  return n;
+}
+
 // The diffuse colour at a hit: the material's map_Kd texture, filtered bilinearly at the
 // interpolated texture coordinates, where it has one and the triangle has coordinates; else Kd.
 inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat) {

@@ -20,6 +20,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   SurfacePoint sp = surface_point(ctx, ray, hit);  // sp.n faces the ray's side
   sp.shading_n = interpolated_normal(*ctx.scene, hit, sp.n);
   const Material& mat = *sp.mat;
+  sp.shading_n = bumped_normal(*ctx.scene, hit, mat, sp.shading_n, -ray.dir);
   const bool deeper = depth < ctx.settings.max_depth;
   switch (mat.surface()) {
     case SurfaceKind::Mirror: {

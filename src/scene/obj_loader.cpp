@@ -62,7 +62,10 @@ class MtlSource {
         if (r.error) return texnames;  // the load stops there
         if (!r.ok) continue;
         loaded.insert(n);
-        for (const MtlMaterial& m : r.materials) texnames.push_back(m.diffuse_map);
+        for (const MtlMaterial& m : r.materials) {
+          texnames.push_back(m.diffuse_map);
+          texnames.push_back(m.bump_map);
+        }
         break;
       }
     }
@@ -200,9 +203,8 @@ Material to_material(const MtlMaterial& m, const std::string& name) {
   return mat;
 }
 
-// The map_Kd textures of a list of materials (their diffuse texture names, in material order),
-// each file read and decoded once. The other maps (bump, Ks, Ka, alpha) are not used by any
-// integrator, so not read.
+// The map_Kd and map_bump textures of a list of materials (texture_names()), each file read and
+// decoded once. The other maps (Ks, Ka, alpha) are not used by any integrator, so not read.
 struct MaterialTextures {
   std::vector<std::string> texnames;            // what this was made for
   std::vector<std::string> problem;             // per material: why its texture is not used
@@ -265,10 +267,14 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
   return t;
 }
 
-std::vector<std::string> diffuse_texnames(const std::vector<MtlMaterial>& materials) {
+// Two names per material, in material order: its map_Kd, its map_bump ("" where none).
+std::vector<std::string> texture_names(const std::vector<MtlMaterial>& materials) {
   std::vector<std::string> names;
-  names.reserve(materials.size());
-  for (const MtlMaterial& m : materials) names.push_back(m.diffuse_map);
+  names.reserve(2 * materials.size());
+  for (const MtlMaterial& m : materials) {
+    names.push_back(m.diffuse_map);
+    names.push_back(m.bump_map);
+  }
   return names;
 }
 
@@ -362,22 +368,32 @@ void add_materials(Scene& scene, const Layout& layout, MaterialTextures textures
     texture_of[k] = uint32_t(scene.textures.size());
     scene.textures.push_back(std::move(*textures.decoded[k]));
   }
-  std::vector<std::string>& problem = textures.problem;
-  size_t missing_textures = 0;
-  std::string first_missing;
+  const std::vector<std::string>& problem = textures.problem;  // per texture name
+  size_t missing[2] = {0, 0};                                  // map_Kd, map_bump
+  std::string first_missing[2];
   for (size_t i = 0; i < layout.materials.size(); ++i) {
     const MtlMaterial& m = layout.materials[i];
     Material mat = to_material(m, name);
-    if (const uint32_t file = textures.file_of[i]; file != kInvalidIndex) {
-      mat.diffuse_texture = texture_of[file];
-      if (mat.diffuse_texture == kInvalidIndex) problem[i] = textures.file_problem[file];
+    uint32_t* slot[2] = {&mat.diffuse_texture, &mat.bump_texture};
+    const std::string* map[2] = {&m.diffuse_map, &m.bump_map};
+    for (size_t k = 0; k < 2; ++k) {
+      std::string why = problem[2 * i + k];
+      if (const uint32_t file = textures.file_of[2 * i + k]; file != kInvalidIndex) {
+        *slot[k] = texture_of[file];
+        if (*slot[k] == kInvalidIndex) why = textures.file_problem[file];
+      }
+      if (!why.empty() && missing[k]++ == 0) first_missing[k] = in_quotes(*map[k]) + ": " + why;
     }
-    if (!problem[i].empty() && missing_textures++ == 0) first_missing = in_quotes(m.diffuse_map) + ": " + problem[i];
+    mat.bump_multiplier = m.bump_multiplier;
     scene.materials.push_back(std::move(mat));
   }
-  if (missing_textures > 0) {
-    warnings.add(std::to_string(missing_textures) + " map_Kd texture(s) not used (first " + first_missing +
+  if (missing[0] > 0) {
+    warnings.add(std::to_string(missing[0]) + " map_Kd texture(s) not used (first " + first_missing[0] +
                  "); those materials use Kd");
+  }
+  if (missing[1] > 0) {
+    warnings.add(std::to_string(missing[1]) + " map_bump texture(s) not used (first " + first_missing[1] +
+                 "); those materials are flat");
   }
   if (layout.uses_default) scene.materials.push_back(Material{});
 }
@@ -418,7 +434,7 @@ Scene load(std::string_view text, const std::string& name, const fs::path& base_
     if (e) std::rethrow_exception(e);
   }
   if (obj.triangle_count() == 0) throw InputError(name + ": scene has no triangles");
-  std::vector<std::string> texnames = diffuse_texnames(layout.materials);
+  std::vector<std::string> texnames = texture_names(layout.materials);
   if (!limits.read_textures) texnames.assign(texnames.size(), std::string());
   if (!early || early->texnames != texnames) {  // not foreseen: read them now
     const auto textures_start = Clock::now();

@@ -52,6 +52,10 @@ struct Material {
   // map_Kd: an index into Scene::textures, or kInvalidIndex. Where present it replaces Kd (the
   // exporters' convention: Sponza's Kd is its texture's mean, so a product would darken it twice).
   uint32_t diffuse_texture = kInvalidIndex;
+  // map_bump / bump: a height map (an index into Scene::textures, or kInvalidIndex) whose values
+  // in [0, 1] times bump_multiplier (-bm) displace the surface along its normal, in scene units.
+  uint32_t bump_texture = kInvalidIndex;
+  float bump_multiplier = 1.0f;
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
   // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.

@@ -48,6 +48,8 @@ uint64_t scene_checksum(const Scene& scene) {
     h.value(m.ni);
     h.value(m.illum);
     h.value(m.diffuse_texture);
+    h.value(m.bump_texture);
+    h.value(m.bump_multiplier);
   }
   h.value(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {

@@ -45,19 +45,47 @@ Vec3 Texture::texel(int x, int y) const {
   return {lut[p[0]], lut[p[1]], lut[p[2]]};
 }
 
-Vec3 Texture::bilinear(float u, float v) const {
-  if (width_ == 0 || height_ == 0) return Vec3{0.0f};
-  // Texel centres sit at half-integers; v runs up the image, rows run down.
-  const float fx = (u - std::floor(u)) * float(width_) - 0.5f;
-  const float fy = (1.0f - (v - std::floor(v))) * float(height_) - 0.5f;
+namespace {
+
+// The four texels around (u, v) and their weights: texel centres sit at half-integers; v runs up
+// the image, rows run down; coordinates repeat.
+struct Footprint {
+  int x0, x1, y0, y1;
+  float ax, ay;
+};
+
+Footprint footprint(float u, float v, int width, int height) {
+  const float fx = (u - std::floor(u)) * float(width) - 0.5f;
+  const float fy = (1.0f - (v - std::floor(v))) * float(height) - 0.5f;
   const float x0f = std::floor(fx), y0f = std::floor(fy);
-  const float ax = fx - x0f, ay = fy - y0f;
   // fx lies in [-0.5, width - 0.5), so x0 in [-1, width - 1]: one compare wraps each side.
   const auto wrap = [](int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); };
-  const int x0 = wrap(int(x0f), width_), x1 = wrap(int(x0f) + 1, width_);
-  const int y0 = wrap(int(y0f), height_), y1 = wrap(int(y0f) + 1, height_);
-  return (texel(x0, y0) * (1.0f - ax) + texel(x1, y0) * ax) * (1.0f - ay) +
-         (texel(x0, y1) * (1.0f - ax) + texel(x1, y1) * ax) * ay;
+  return {wrap(int(x0f), width),
+          wrap(int(x0f) + 1, width),
+          wrap(int(y0f), height),
+          wrap(int(y0f) + 1, height),
+          fx - x0f,
+          fy - y0f};
+}
+
+}  // namespace
+
+float Texture::height(float u, float v) const {
+  if (width_ == 0 || height_ == 0) return 0.0f;
+  const Footprint f = footprint(u, v, width_, height_);
+  const auto h = [&](int x, int y) {
+    const uint8_t* p = &srgb_[3 * (size_t(y) * size_t(width_) + size_t(x))];
+    return float(int(p[0]) + int(p[1]) + int(p[2])) * (1.0f / 765.0f);
+  };
+  return (h(f.x0, f.y0) * (1.0f - f.ax) + h(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
+         (h(f.x0, f.y1) * (1.0f - f.ax) + h(f.x1, f.y1) * f.ax) * f.ay;
+}
+
+Vec3 Texture::bilinear(float u, float v) const {
+  if (width_ == 0 || height_ == 0) return Vec3{0.0f};
+  const Footprint f = footprint(u, v, width_, height_);
+  return (texel(f.x0, f.y0) * (1.0f - f.ax) + texel(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
+         (texel(f.x0, f.y1) * (1.0f - f.ax) + texel(f.x1, f.y1) * f.ax) * f.ay;
 }
 
 EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {

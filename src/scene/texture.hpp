@@ -25,6 +25,9 @@ class Texture {
   Vec3 bilinear(float u, float v) const;
   // The linear colour of texel (x, y), rows from the top.
   Vec3 texel(int x, int y) const;
+  // A bump map's height in [0, 1] at (u, v): the stored bytes as data (no sRGB decoding), the
+  // mean of the channels, filtered bilinearly with repeat as bilinear() is.
+  float height(float u, float v) const;
   // The texels as stored: 8-bit sRGB, RGB, rows from the top.
   const std::vector<uint8_t>& srgb() const { return srgb_; }
 
