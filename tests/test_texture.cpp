@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/texture.hpp"
@@ -50,10 +51,11 @@ TEST(Texture, TexelsAppearWhereTheirCoordinatesSay) {
   const Scene scene = load_obj(dir + "/quad.obj", [&](const std::string& w) { warnings.push_back(w); });
   EXPECT_TRUE(warnings.empty()) << warnings.front();
   ASSERT_EQ(scene.textures.size(), 1u);
-  // A 4x4 image of the quad, each pixel centre on a texel centre; whitted with no light and
-  // ambient 1 shows the diffuse colour itself.
+  // A 12x12 image of the quad, pixels 1, 4, 7 and 10 of each row and column centred on the texel
+  // centres (a texel spans three pixels: the ray cone asks for no coarser level than the texels);
+  // whitted with no light and ambient 1 shows the diffuse colour itself.
   RenderSettings s;
-  s.width = s.height = 4;
+  s.width = s.height = 12;
   s.integrator = Integrator::Whitted;
   s.ambient = 1.0f;
   const float fov = 2.0f * std::atan(1.0f / 4.0f) * 180.0f / float(M_PI);
@@ -65,7 +67,7 @@ TEST(Texture, TexelsAppearWhereTheirCoordinatesSay) {
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 4; ++x) {
       const uint8_t* t = &rgb[size_t(y * 4 + x) * 3];  // image row y is the top row y: v = 1 at the top
-      const Vec3 c = fb.radiance(x, y);
+      const Vec3 c = fb.radiance(3 * x + 1, 3 * y + 1);
       EXPECT_NEAR(c.x, srgb_to_linear(t[0]), 1e-4f) << x << "," << y;
       EXPECT_NEAR(c.y, srgb_to_linear(t[1]), 1e-4f) << x << "," << y;
       EXPECT_NEAR(c.z, srgb_to_linear(t[2]), 1e-4f) << x << "," << y;
@@ -116,12 +118,78 @@ TEST(Texture, AnyCaseLookupMatchesEveryComponent) {
   EXPECT_FALSE(find_file_any_case(dir, "maps/other.jpg"));
 }
 
+TEST(Texture, MipLevelsAverageInLinearLight) {
+  // A 4 x 4 checker of black and white: each 2 x 2 block of level 1 and the 1 x 1 level 2 hold
+  // linear 0.5 (sRGB code 188), not the code 128 an average of the codes would give.
+  std::vector<uint8_t> rgb;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) rgb.push_back((x + y) % 2 ? 255 : 0);
+  const Texture t(4, 4, rgb);
+  EXPECT_EQ(t.levels(), 3);
+  for (const float lod : {1.0f, 1.5f, 2.0f, 7.0f}) {
+    for (const float u : {0.1f, 0.6f}) {
+      const Vec3 c = t.filtered(u, 0.3f, lod);
+      EXPECT_NEAR(c.x, srgb_to_linear(188), 1e-6f) << lod;
+      EXPECT_EQ(c.x, c.z);
+    }
+  }
+  // Level 0 is the texels: bilinear, and between levels a blend.
+  EXPECT_EQ(t.filtered(0.125f, 0.125f, 0.0f).x, t.bilinear(0.125f, 0.125f).x);
+  EXPECT_EQ(t.filtered(0.125f, 0.125f, -3.0f).x, t.bilinear(0.125f, 0.125f).x);
+  const float half = t.filtered(0.125f, 0.125f, 0.5f).x;
+  EXPECT_NEAR(half, 0.5f * (t.bilinear(0.125f, 0.125f).x + srgb_to_linear(188)), 1e-6f);
+  // Odd sizes halve down to 1 x 1 too.
+  EXPECT_EQ(Texture(5, 3, std::vector<uint8_t>(5 * 3 * 3, 9)).levels(), 3);
+}
+
+TEST(Texture, RayConesFilterDistantTexturesAndKeepNearOnesSharp) {
+  // A 10 x 10 plane under a 1024 x 1024 checker of single texels, seen from above by whitted with
+  // ambient light only (each pixel: its texture colour). From far away a pixel spans ~37 texels:
+  // with the cone's mip level every pixel is the checker's mean (linear 0.5); a point sample would
+  // be 0 or 1. From close by a texel spans many pixels: the texels' own black and white show.
+  const std::string dir = test::temp_dir();
+  std::vector<uint8_t> rgb(size_t(1024) * 1024 * 3);
+  for (size_t y = 0; y < 1024; ++y)
+    for (size_t x = 0; x < 1024; ++x)
+      for (size_t c = 0; c < 3; ++c) rgb[(y * 1024 + x) * 3 + c] = (x + y) % 2 ? 255 : 0;
+  ASSERT_TRUE(stbi_write_png((dir + "/checker.png").c_str(), 1024, 1024, 3, rgb.data(), 1024 * 3));
+  std::ofstream(dir + "/plane.obj") << "mtllib plane.mtl\nv -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl c\nf 1/1 2/2 3/3 4/4\n";
+  std::ofstream(dir + "/plane.mtl") << "newmtl c\nKd 0.5 0.5 0.5\nmap_Kd checker.png\n";
+  const std::string flags = " --integrator whitted --ambient 1 --width 64 --height 64 --fov 20 --exr float -q -o ";
+  ASSERT_EQ(
+      test::run_tracer("render " + dir + "/plane.obj --eye 0.01,0.02,20 --look 0.01,0.02,0" + flags + dir + "/far.exr")
+          .exit_code,
+      0);
+  const Framebuffer far = read_exr(dir + "/far.exr");
+  for (int y = 8; y < 56; ++y)
+    for (int x = 8; x < 56; ++x) ASSERT_NEAR(far.radiance(x, y).x, 0.5f, 0.02f) << x << "," << y;
+  ASSERT_EQ(test::run_tracer("render " + dir + "/plane.obj --eye 0.0012,0.0013,0.05 --look 0.0012,0.0013,0" + flags +
+                             dir + "/near.exr")
+                .exit_code,
+            0);
+  const Framebuffer near = read_exr(dir + "/near.exr");
+  float lo = 1.0f, hi = 0.0f;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      lo = std::min(lo, near.radiance(x, y).x);
+      hi = std::max(hi, near.radiance(x, y).x);
+    }
+  EXPECT_LT(lo, 0.1f);
+  EXPECT_GT(hi, 0.9f);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Texture, TheSharedScenesFindAllTheirDiffuseTextures) {
   if (!test::have_shared_scenes()) GTEST_SKIP() << "needs ../shared/scenes";
   for (const char* path : {"sponza/sponza.obj", "sibenik/sibenik.obj"}) {
     std::vector<std::string> warnings;
     const Scene scene = load_obj(test::scene_path(path), [&](const std::string& w) { warnings.push_back(w); });
-    for (const std::string& w : warnings) EXPECT_EQ(w.find("map_Kd"), std::string::npos) << w;
+    for (const std::string& w : warnings) {
+      EXPECT_EQ(w.find("map_Kd"), std::string::npos) << w;
+      EXPECT_EQ(w.find("map_bump"), std::string::npos) << w;
+    }
     EXPECT_GT(scene.textures.size(), 0u) << path;
     EXPECT_FALSE(scene.corner_uvs.empty()) << path;
   }

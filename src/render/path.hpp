@@ -51,6 +51,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   bool unsampled = true;
   float bsdf_pdf = 0.0f;
   Vec3 prev_n{0.0f};  // the geometric normal at the vertex the ray left, on its side
+  RayCone cone{0.0f, ctx.camera.pixel_spread()};
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!accel.intersect(ray, hit)) {
@@ -73,7 +74,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
       radiance += beta * mat.ke * w;
     }
     if (depth >= s.max_depth) break;
-    const Vec3 kd = diffuse_color(scene, hit, mat);
+    const Vec3 kd = diffuse_color(scene, hit, mat, cone, std::fabs(dot(ray.dir, sp.n)));
     const Bsdf bsdf = material_bsdf(mat, kd, sp.shading_n, sp.front);
     const Vec3 wo = -ray.dir;
     if (depth == 0 && first) {
@@ -141,6 +142,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     // back out): such a sample has no consistent meaning, so the path ends.
     if ((dot(bs.wi, sp.n) < 0.0f) != bs.transmitted) break;
     beta = beta * bs.weight;
+    cone = bs.delta ? RayCone{cone.width_at(hit.t), cone.spread} : RayCone{};
     unsampled = bs.delta || bs.transmitted;
     bsdf_pdf = bs.pdf;
     prev_n = sp.n;

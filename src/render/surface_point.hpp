@@ -90,14 +90,44 @@ inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& ma
   return n;
 }
 
-// The diffuse colour at a hit: the material's map_Kd texture, filtered bilinearly at the
-// interpolated texture coordinates, where it has one and the triangle has coordinates; else Kd.
-inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat) {
+// The footprint of the rays through one pixel, as a cone (Akenine-Moller et al. 2019, "Texture
+// Level of Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems ch. 20): its width where
+// the ray starts and the angle it widens by. A camera ray's cone spans its pixel; a mirror or
+// glass keeps the cone going (flat surfaces: no change of spread); after any other bounce a path
+// no longer has a footprint (width 0: the finest texels).
+struct RayCone {
+  float width = 0.0f, spread = 0.0f;
+  bool active() const { return spread > 0.0f; }
+  // The cone's width at distance t along the ray.
+  float width_at(float t) const { return width + spread * t; }
+};
+
+// The texture level of detail of a cone of width `width` meeting the hit triangle at incidence
+// cosine `cos_incidence`: log2 of the texels its footprint spans, through the triangle's ratio of
+// texture area (in texels) to surface area.
+inline float texture_lod(const Scene& scene, const Hit& hit, const Texture& t, float width, float cos_incidence) {
+  const Triangle& tri = scene.triangles[hit.tri];
+  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
+  const float texels = std::fabs((c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y)) *
+                       float(t.width()) * float(t.height());
+  const float area = length(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+  const float lod = 0.5f * std::log2(texels / area) + std::log2(width / std::max(cos_incidence, 1e-3f));
+  return std::isfinite(lod) ? lod : 0.0f;
+}
+
+// The diffuse colour at a hit: the material's map_Kd texture at the interpolated texture
+// coordinates, filtered to the footprint of `cone` at the hit (trilinearly between mip levels;
+// bilinearly from the texels where the cone is inactive), where it has one and the triangle has
+// coordinates; else Kd. `cos_incidence`: |cos| of the ray with the surface.
+inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat, const RayCone& cone = {},
+                          float cos_incidence = 1.0f) {
   if (mat.diffuse_texture == kInvalidIndex || scene.corner_uvs.empty()) return mat.kd;
   const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float w = 1.0f - hit.u - hit.v;
-  return scene.textures[mat.diffuse_texture].bilinear(c[0].x * w + c[1].x * hit.u + c[2].x * hit.v,
-                                                      c[0].y * w + c[1].y * hit.u + c[2].y * hit.v);
+  const float u = c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, v = c[0].y * w + c[1].y * hit.u + c[2].y * hit.v;
+  const Texture& t = scene.textures[mat.diffuse_texture];
+  if (!cone.active()) return t.bilinear(u, v);
+  return t.filtered(u, v, texture_lod(scene, hit, t, cone.width_at(hit.t), cos_incidence));
 }
 
 }  // namespace tracer

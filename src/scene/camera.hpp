@@ -40,6 +40,8 @@ class Camera {
     inv_h_ = 1.0f / float(height);
   }
 
+  // The angle one pixel spans at the image centre: the spread of a ray cone through a pixel.
+  float pixel_spread() const { return 2.0f * length(dv_) * inv_h_; }
   // The ray through the centre of pixel (x, y).
   Ray primary_ray(int x, int y) const { return ray_through(float(x) + 0.5f, float(y) + 0.5f); }
 

@@ -34,10 +34,48 @@ std::string lower(std::string s) {
   return s;
 }
 
+// Linear [0, 1] back to an sRGB byte, through a 4096-entry table (building a mip pyramid calls
+// it for a third of the texels again: std::pow each time cost tens of milliseconds a texture).
+const std::array<uint8_t, 4097> kLinearToSrgb = [] {
+  std::array<uint8_t, 4097> t{};
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double c = double(i) / 4096.0;
+    const double s = c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+    t[i] = uint8_t(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
+  }
+  return t;
+}();
+
 }  // namespace
 
 Texture::Texture(int width, int height, std::vector<uint8_t> srgb)
-    : width_(width), height_(height), srgb_(std::move(srgb)) {}
+    : width_(width), height_(height), srgb_(std::move(srgb)) {
+  // The pyramid: each level the linear mean of 2 x 2 texels of the one below (the last row or
+  // column of an odd size counted twice), until 1 x 1.
+  int w = width_, h = height_;
+  const std::vector<uint8_t>* below = &srgb_;
+  while (w > 1 || h > 1) {
+    const int nw = std::max(1, w / 2), nh = std::max(1, h / 2);
+    Level level{nw, nh, std::vector<uint8_t>(size_t(nw) * size_t(nh) * 3)};
+    for (int y = 0; y < nh; ++y) {
+      for (int x = 0; x < nw; ++x) {
+        const int xs[2] = {std::min(2 * x, w - 1), std::min(2 * x + 1, w - 1)};
+        const int ys[2] = {std::min(2 * y, h - 1), std::min(2 * y + 1, h - 1)};
+        for (int c = 0; c < 3; ++c) {
+          float sum = 0.0f;
+          for (int j : ys)
+            for (int i : xs) sum += kSrgbToLinear[(*below)[(size_t(j) * size_t(w) + size_t(i)) * 3 + size_t(c)]];
+          level.srgb[(size_t(y) * size_t(nw) + size_t(x)) * 3 + size_t(c)] =
+              kLinearToSrgb[size_t(std::lround(std::min(sum * 0.25f, 1.0f) * 4096.0f))];
+        }
+      }
+    }
+    mips_.push_back(std::move(level));
+    below = &mips_.back().srgb;
+    w = nw;
+    h = nh;
+  }
+}
 
 Vec3 Texture::texel(int x, int y) const {
   const auto& lut = kSrgbToLinear;
@@ -79,6 +117,28 @@ float Texture::height(float u, float v) const {
   };
   return (h(f.x0, f.y0) * (1.0f - f.ax) + h(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
          (h(f.x0, f.y1) * (1.0f - f.ax) + h(f.x1, f.y1) * f.ax) * f.ay;
+}
+
+Vec3 Texture::bilinear_at(const Level& level, float u, float v) const {
+  const Footprint f = footprint(u, v, level.width, level.height);
+  const auto& lut = kSrgbToLinear;
+  const auto t = [&](int x, int y) {
+    const uint8_t* p = &level.srgb[(size_t(y) * size_t(level.width) + size_t(x)) * 3];
+    return Vec3{lut[p[0]], lut[p[1]], lut[p[2]]};
+  };
+  return (t(f.x0, f.y0) * (1.0f - f.ax) + t(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
+         (t(f.x0, f.y1) * (1.0f - f.ax) + t(f.x1, f.y1) * f.ax) * f.ay;
+}
+
+Vec3 Texture::filtered(float u, float v, float lod) const {
+  if (!(lod > 0.0f) || mips_.empty()) return bilinear(u, v);
+  const float top = float(mips_.size());
+  if (lod >= top) return bilinear_at(mips_.back(), u, v);
+  const int l = int(lod);
+  const float a = lod - float(l);
+  const Vec3 lo = l == 0 ? bilinear(u, v) : bilinear_at(mips_[size_t(l) - 1], u, v);
+  const Vec3 hi = bilinear_at(mips_[size_t(l)], u, v);
+  return lo * (1.0f - a) + hi * a;
 }
 
 Vec3 Texture::bilinear(float u, float v) const {

@@ -23,6 +23,11 @@ class Texture {
   // Linear colour at texture coordinates (u, v) as OBJ gives them: v = 0 is the image's bottom
   // row. Bilinear between the four nearest texel centres; coordinates wrap.
   Vec3 bilinear(float u, float v) const;
+  // The same filtered to level of detail `lod` (0: the texels; each level halves the resolution,
+  // its texels the mean of 2 x 2 of the level below, averaged in linear light): trilinear, between
+  // the two levels around lod; lod <= 0 is bilinear().
+  Vec3 filtered(float u, float v, float lod) const;
+  int levels() const { return 1 + int(mips_.size()); }
   // The linear colour of texel (x, y), rows from the top.
   Vec3 texel(int x, int y) const;
   // A bump map's height in [0, 1] at (u, v): the stored bytes as data (no sRGB decoding), the
@@ -32,8 +37,14 @@ class Texture {
   const std::vector<uint8_t>& srgb() const { return srgb_; }
 
  private:
+  struct Level {
+    int width, height;
+    std::vector<uint8_t> srgb;
+  };
+  Vec3 bilinear_at(const Level& level, float u, float v) const;
   int width_ = 0, height_ = 0;
   std::vector<uint8_t> srgb_;
+  std::vector<Level> mips_;  // levels 1, 2, ... down to 1 x 1 (level 0 is srgb_)
 };
 
 // What a scene's textures may take: a texture larger than max_texels is refused (a decompression
@@ -48,7 +59,8 @@ struct EncodedTexture {
   std::string name;
   std::string bytes;
   int width = 0, height = 0;
-  uint64_t decoded_bytes() const { return uint64_t(width) * uint64_t(height) * 3; }
+  // Its texels and mip levels (a third more) once decoded.
+  uint64_t decoded_bytes() const { return uint64_t(width) * uint64_t(height) * 4; }
 };
 
 // Reads any image stb_image reads (PNG, JPEG, ...) and its header: throws InputError naming the
