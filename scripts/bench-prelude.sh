@@ -3,9 +3,12 @@
 # --stats-json file (pretty-printed: one key per line).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[1]}")/.."
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
-T=build/release/tracer
+# TRACER=path/to/tracer measures another build (an older commit's) and builds nothing.
+if [[ -z ${TRACER:-} ]]; then
+  cmake --preset release >/dev/null
+  cmake --build --preset release >/dev/null
+fi
+T=${TRACER:-build/release/tracer}
 O=docs/bench
 mkdir -p "$O"
 field() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Less noise per second (issue 24): for each scene, a 4096-spp reference of the renderer itself,
+# then renders of 16 ... 1024 spp, each one's render time and RMSE (of the displayed, tone-mapped values) against the
+# reference; from them the error's slope between 16 and 256 spp and the time to RMSE 0.02, 0.01,
+# 0.005 and 0.0025 (interpolated in log-log between the renders that bracket it; "-" when even
+# 1024 spp does not reach it). 512x512, 2 threads, path. About 12 minutes per Cornell scene and
+# 35 for the sky-lit Sponza on this machine.
+#   scripts/benchmarks-noise.sh [SCENE ...]    scenes: cornell-original cornell-water sponza-sky
+#   TRACER=path/to/tracer scripts/benchmarks-noise.sh ...   another build (an older commit's)
+# Writes docs/bench/noise-SCENE.md (or noise-SCENE-LABEL.md with LABEL=...).
+source "$(dirname "$0")/bench-prelude.sh"
+label=${LABEL:+-$LABEL}
+scenes=("$@")
+[[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell-original cornell-water sponza-sky)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+for scene in "${scenes[@]}"; do
+  case $scene in
+    cornell-original | cornell-water) flags=(--view "$scene") ;;
+    sponza-sky) flags=(--view sponza --env 1,1,1 --no-scene-lights) ;;
+    *) echo "unknown scene $scene" >&2; exit 2 ;;
+  esac
+  common=("${flags[@]}" --integrator path --width 512 --height 512 --threads 2 -q)
+  $T render "${common[@]}" --spp 4096 --seed 99 -o "$work/ref.png"
+  rows=()
+  for spp in 16 32 64 128 256 512 1024; do
+    $T render "${common[@]}" --spp $spp -o "$work/img.png" --stats-json "$work/s.json"
+    ms=$(field "$work/s.json" render_ms)
+    rmse=$($T compare "$work/ref.png" "$work/img.png" | sed -E 's/.*RMSE ([^,]*),.*/\1/')
+    rows+=("$spp $ms $rmse")
+  done
+  printf '%s\n' "${rows[@]}" | awk -v scene="$scene" -v tracer="$($T --version 2>/dev/null | head -1)" '
+    { spp[NR] = $1; s[NR] = $2 / 1000; e[NR] = $3; n = NR }
+    END {
+      printf "%s, 512x512, path, 2 threads (%s); RMSE of the displayed values (tone-mapped, 8-bit, in [0, 1]) against 4096 spp (seed 99)\n\n", scene, tracer
+      print "| spp | render s | Msamples/s | RMSE |"
+      print "|---:|---:|---:|---:|"
+      for (i = 1; i <= n; ++i) printf "| %d | %.2f | %.3f | %.5f |\n", spp[i], s[i], 512 * 512 * spp[i] / s[i] / 1e6, e[i]
+      for (i = 1; i <= n; ++i) { if (spp[i] == 16) a = i; if (spp[i] == 256) b = i }
+      printf "\nslope of RMSE against spp, 16 to 256: N^%.3f\n\n", log(e[b] / e[a]) / log(spp[b] / spp[a])
+      print "| RMSE | seconds to reach it |"
+      print "|---:|---:|"
+      split("0.02 0.01 0.005 0.0025", targets, " ")
+      for (t = 1; t <= 4; ++t) {
+        x = targets[t]; out = "-"
+        if (e[1] <= x) out = sprintf("< %.2f", s[1])
+        else for (i = 1; i < n; ++i) if (e[i] > x && e[i + 1] <= x) {
+          f = log(e[i] / x) / log(e[i] / e[i + 1])
+          out = sprintf("%.2f", exp(log(s[i]) + f * (log(s[i + 1]) - log(s[i]))))
+        }
+        printf "| %s | %s |\n", x, out
+      }
+    }' | tee "$O/noise-$scene$label.md"
+done
