@@ -20,7 +20,6 @@ namespace tracer::driver {
 // The --aov layers: first-hit albedo and shading normal, for a denoiser.
 struct Aovs {
   bool albedo = false, normal = false;
-  bool any() const { return albedo || normal; }
 };
 
 struct FrameSequence {

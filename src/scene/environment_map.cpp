@@ -16,7 +16,6 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Vec3> texels, 
     : width_(width), height_(height), rotation_(rotation_degrees / 360.0f), texels_(std::move(texels)) {
   rotation_ -= std::floor(rotation_);
   std::vector<float> weights(texels_.size());
-  double sum[3] = {0.0, 0.0, 0.0}, solid = 0.0;
   for (int y = 0; y < height_; ++y) {
     // The row's share of the sphere: sin(theta) at its centre (cells at the poles are small).
     const float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(height_));
@@ -24,13 +23,8 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Vec3> texels, 
       Vec3& t = texels_[size_t(y) * size_t(width_) + size_t(x)];
       for (float* c : {&t.x, &t.y, &t.z}) *c = std::isfinite(*c) && *c > 0.0f ? *c : 0.0f;
       weights[size_t(y) * size_t(width_) + size_t(x)] = luminance(t) * sin_theta;
-      sum[0] += double(t.x) * sin_theta;
-      sum[1] += double(t.y) * sin_theta;
-      sum[2] += double(t.z) * sin_theta;
-      solid += sin_theta;
     }
   }
-  if (solid > 0.0) mean_ = Vec3{float(sum[0] / solid), float(sum[1] / solid), float(sum[2] / solid)};
   distribution_ = Distribution2D(weights, size_t(width_), size_t(height_));
 }
 

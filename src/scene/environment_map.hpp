@@ -27,8 +27,6 @@ class EnvironmentMap {
   // solid angle; false (pdf 0) for a black map.
   bool sample(float u1, float u2, Vec3& dir, float& pdf) const;
   float pdf(Vec3 dir) const;
-  // The mean radiance over the sphere (weighted by solid angle): a uniform map's value.
-  Vec3 mean() const { return mean_; }
 
  private:
   Vec2 to_uv(Vec3 dir) const;
@@ -37,7 +35,6 @@ class EnvironmentMap {
   float rotation_ = 0.0f;  // in turns
   std::vector<Vec3> texels_;
   Distribution2D distribution_;
-  Vec3 mean_{0.0f};
 };
 
 }  // namespace tracer

@@ -106,28 +106,31 @@ Footprint footprint(float u, float v, int width, int height) {
           fy - y0f};
 }
 
+// The bilinear blend of what `at(x, y)` gives at the footprint's four texels.
+template <class At>
+auto blend(const Footprint& f, const At& at) {
+  return (at(f.x0, f.y0) * (1.0f - f.ax) + at(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
+         (at(f.x0, f.y1) * (1.0f - f.ax) + at(f.x1, f.y1) * f.ax) * f.ay;
+}
+
 }  // namespace
 
 float Texture::height(float u, float v) const {
   if (width_ == 0 || height_ == 0) return 0.0f;
   const Footprint f = footprint(u, v, width_, height_);
-  const auto h = [&](int x, int y) {
+  return blend(f, [&](int x, int y) {
     const uint8_t* p = &srgb_[3 * (size_t(y) * size_t(width_) + size_t(x))];
     return float(int(p[0]) + int(p[1]) + int(p[2])) * (1.0f / 765.0f);
-  };
-  return (h(f.x0, f.y0) * (1.0f - f.ax) + h(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
-         (h(f.x0, f.y1) * (1.0f - f.ax) + h(f.x1, f.y1) * f.ax) * f.ay;
+  });
 }
 
 Vec3 Texture::bilinear_at(const Level& level, float u, float v) const {
   const Footprint f = footprint(u, v, level.width, level.height);
   const auto& lut = kSrgbToLinear;
-  const auto t = [&](int x, int y) {
+  return blend(f, [&](int x, int y) {
     const uint8_t* p = &level.srgb[(size_t(y) * size_t(level.width) + size_t(x)) * 3];
     return Vec3{lut[p[0]], lut[p[1]], lut[p[2]]};
-  };
-  return (t(f.x0, f.y0) * (1.0f - f.ax) + t(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
-         (t(f.x0, f.y1) * (1.0f - f.ax) + t(f.x1, f.y1) * f.ax) * f.ay;
+  });
 }
 
 Vec3 Texture::filtered(float u, float v, float lod) const {
@@ -143,9 +146,7 @@ Vec3 Texture::filtered(float u, float v, float lod) const {
 
 Vec3 Texture::bilinear(float u, float v) const {
   if (width_ == 0 || height_ == 0) return Vec3{0.0f};
-  const Footprint f = footprint(u, v, width_, height_);
-  return (texel(f.x0, f.y0) * (1.0f - f.ax) + texel(f.x1, f.y0) * f.ax) * (1.0f - f.ay) +
-         (texel(f.x0, f.y1) * (1.0f - f.ax) + texel(f.x1, f.y1) * f.ax) * f.ay;
+  return blend(footprint(u, v, width_, height_), [&](int x, int y) { return texel(x, y); });
 }
 
 EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
