@@ -199,8 +199,19 @@ double image_mean(const Framebuffer& fb) {
 }
 
 TEST(Path, LightSamplingAndBsdfSamplingConvergeToTheSameImage) {
+  // The Cornell box with its lamp three times as wide (so BSDF sampling alone finds it often
+  // enough for a quadrant's mean to be known within ~1.5 % at 512 spp; the original lamp leaves
+  // the floor's quadrants 5-12 % apart from seed to seed): MIS and BSDF-only sampling agree.
   if (!test::have_shared_scenes()) GTEST_SKIP() << "needs ../shared/scenes";
-  const Scene scene = load_obj(test::scene_path("cornell-box/CornellBox-Original.obj"), [](const std::string&) {});
+  Scene scene = load_obj(test::scene_path("cornell-box/CornellBox-Original.obj"), [](const std::string&) {});
+  for (size_t t = 0; t < scene.triangles.size(); ++t) {
+    if (max_component(scene.materials[scene.tri_material[t]].ke) <= 0.0f) continue;
+    for (Vec3* v : {&scene.triangles[t].v0, &scene.triangles[t].v1, &scene.triangles[t].v2}) {
+      v->x = 3.0f * v->x;
+      v->z = 3.0f * v->z;
+    }
+  }
+  scene.finalize();
   const CameraSpec cam{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 60.0f};
   RenderSettings s;
   s.width = s.height = 24;
