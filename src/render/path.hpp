@@ -21,8 +21,9 @@
 namespace tracer {
 
 // Sample dimensions, in sets (PixelSampler::get): set 0 places the sample in the pixel (x, y);
-// bounce b takes set 1 + 3b (the light's choice and two for the point on it), set 2 + 3b (the
-// BSDF's lobe and two for the direction) and set 3 + 3b (Russian roulette).
+// bounce b takes set 1 + 3b (two for the point on the light, then the light's choice), set 2 + 3b
+// (two for the direction, then the BSDF's lobe) and set 3 + 3b (Russian roulette). The 2D samples
+// take a set's first two dimensions, the pair that forms (0,m,2)-nets.
 inline constexpr uint32_t kPixelSet = 0;
 constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
 constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
@@ -87,15 +88,15 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
       // One light sample: L * f * cos / pdf, weighted against BSDF sampling.
       Vec3 wi, emitted{0.0f};
       float light_pdf = 0.0f, distance = kInfinity;
-      if (nee && lu[0] < p_env) {
-        if (env.sample(sp.n, lu[1], lu[2], wi, light_pdf)) {
+      if (nee && lu[2] < p_env) {
+        if (env.sample(sp.n, lu[0], lu[1], wi, light_pdf)) {
           light_pdf *= p_env;
           emitted = env.radiance(wi);
         }
       } else if (nee) {
         EmitterSample es;
-        const float u_select = (lu[0] - p_env) / (1.0f - p_env);
-        if (scene.emitters.sample(scene, sp.origin, std::min(u_select, 0x1.fffffep-1f), lu[1], lu[2], es)) {
+        const float u_select = (lu[2] - p_env) / (1.0f - p_env);
+        if (scene.emitters.sample(scene, sp.origin, std::min(u_select, 0x1.fffffep-1f), lu[0], lu[1], es)) {
           wi = es.wi;
           light_pdf = es.pdf * (1.0f - p_env);
           emitted = es.radiance;
@@ -137,7 +138,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     }
     const std::array<float, 3> bu = sampler.get<3>(bsdf_set(depth));
     BsdfSample bs;
-    if (!bsdf.sample(wo, bu[0], bu[1], bu[2], bs)) break;
+    if (!bsdf.sample(wo, bu[2], bu[0], bu[1], bs)) break;
     // The shading normal may send a reflection through the geometric surface (or a refraction
     // back out): such a sample has no consistent meaning, so the path ends.
     if ((dot(bs.wi, sp.n) < 0.0f) != bs.transmitted) break;
