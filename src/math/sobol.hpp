@@ -119,13 +119,14 @@ constexpr uint32_t combine_seed(uint32_t seed, uint32_t v) {
 // Dimensions 0..N-1 (N <= 4) of sample `index` of the sequence scrambled by `seed`, as 32-bit
 // fractions. The cost is one hash per dimension: the index's shuffle is itself an Owen scramble
 // of the van der Corput sequence (dimension 0), so that dimension needs nothing more.
+// `reversed` is reverse_bits(index), which every set of a sample shares.
 template <int N>
-constexpr std::array<uint32_t, N> sobol_burley_bits(uint32_t index, uint32_t seed) {
+constexpr std::array<uint32_t, N> sobol_burley_bits(uint32_t index, uint32_t reversed, uint32_t seed) {
   static_assert(N >= 1 && N <= 4);
   using namespace sobol_detail;
   // The shuffled index j, bit-reversed (bit p of r is bit 31-p of j). Dimension 0's point of j
   // is reverse(j) = r.
-  const uint32_t r = laine_karras(reverse_bits(index), seed);
+  const uint32_t r = laine_karras(reversed, seed);
   std::array<uint32_t, N> x{};
   x[0] = r;
   if constexpr (N > 1) {
@@ -149,15 +150,21 @@ constexpr std::array<uint32_t, N> sobol_burley_bits(uint32_t index, uint32_t see
   return x;
 }
 
+template <int N>
+constexpr std::array<uint32_t, N> sobol_burley_bits(uint32_t index, uint32_t seed) {
+  return sobol_burley_bits<N>(index, sobol_detail::reverse_bits(index), seed);
+}
+
 // The samples of one pixel: dimension set `set` gives N <= 4 dimensions in [0, 1), stratified
 // over the pixel's samples and independent of every other set's.
+// Callers take only the dimensions they use: each costs a hash.
 struct PixelSampler {
-  uint32_t key, index;
+  uint32_t key, index, reversed;
   constexpr PixelSampler(uint32_t pixel, uint32_t sample, uint32_t seed = 0)
-      : key(pcg_hash(pixel ^ (seed * 0x9e3779b9u))), index(sample) {}
+      : key(pcg_hash(pixel ^ (seed * 0x9e3779b9u))), index(sample), reversed(sobol_detail::reverse_bits(sample)) {}
   template <int N>
   constexpr std::array<float, N> get(uint32_t set) const {
-    const std::array<uint32_t, N> bits = sobol_burley_bits<N>(index, pcg_hash(key + set * 0x68e31da4u));
+    const std::array<uint32_t, N> bits = sobol_burley_bits<N>(index, reversed, pcg_hash(key + set * 0x68e31da4u));
     std::array<float, N> u{};
     for (int d = 0; d < N; ++d) u[d] = to_unit_float(bits[d]);
     return u;

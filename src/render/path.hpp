@@ -22,8 +22,9 @@ namespace tracer {
 
 // Sample dimensions, in sets (PixelSampler::get): set 0 places the sample in the pixel (x, y);
 // bounce b takes set 1 + 3b (two for the point on the light, then the light's choice), set 2 + 3b
-// (two for the direction, then the BSDF's lobe) and set 3 + 3b (Russian roulette). The 2D samples
-// take a set's first two dimensions, the pair that forms (0,m,2)-nets.
+// (two for the direction, then the BSDF's lobe; glass takes only its lobe) and set 3 + 3b (Russian
+// roulette). The 2D samples take a set's first two dimensions, the pair that forms (0,m,2)-nets;
+// a choice that has one outcome (one light, one lobe) draws no dimension, as each costs a hash.
 inline constexpr uint32_t kPixelSet = 0;
 constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
 constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
@@ -37,6 +38,28 @@ struct FirstHit {
   Vec3 albedo{0.0f}, normal{0.0f};
 };
 
+// A 2D sample with the third dimension (a choice with one outcome) at 0.
+inline std::array<float, 3> with_third(std::array<float, 2> u) { return {u[0], u[1], 0.0f}; }
+
+// bsdf.sample with the dimensions of `set` its kind uses: a mirror none, glass one (its lobe), a
+// smooth surface two for the direction and a third for the lobe when it has two.
+inline bool sample_bsdf(const Bsdf& bsdf, Vec3 wo, const PixelSampler& sampler, uint32_t set, BsdfSample& out) {
+  switch (bsdf.kind()) {
+    case Bsdf::Kind::Mirror:
+      return bsdf.sample(wo, 0.0f, 0.0f, 0.0f, out);
+    case Bsdf::Kind::Dielectric:
+      return bsdf.sample(wo, sampler.get<1>(set)[0], 0.0f, 0.0f, out);
+    case Bsdf::Kind::Smooth:
+      break;
+  }
+  if (!bsdf.two_lobes()) {
+    const std::array<float, 2> u = sampler.get<2>(set);
+    return bsdf.sample(wo, 0.0f, u[0], u[1], out);  // u_lobe 0 picks the one lobe there is
+  }
+  const std::array<float, 3> u = sampler.get<3>(set);
+  return bsdf.sample(wo, u[2], u[0], u[1], out);
+}
+
 template <class Accel>
 Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PixelSampler& sampler,
                    RayCounts& counts, FirstHit* first = nullptr) {
@@ -46,6 +69,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   const bool nee = s.light_sampling == LightSampling::Mis;
   // A light sample picks the environment with this probability, else an emitter.
   const float p_env = env.black() ? 0.0f : scene.emitters.empty() ? 1.0f : 0.5f;
+  const bool choose_light = (p_env > 0.0f && p_env < 1.0f) || scene.emitters.size() > 1;
   Vec3 radiance{0.0f}, beta{1.0f};
   // No light sample could have found what this ray finds: the last bounce was a delta lobe (or
   // this is the camera ray), or it went through the surface, where light samples never go.
@@ -84,7 +108,8 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
       first->normal = sp.shading_n;
     }
     if (!bsdf.delta()) {
-      const std::array<float, 3> lu = sampler.get<3>(light_set(depth));
+      const std::array<float, 3> lu =
+          choose_light ? sampler.get<3>(light_set(depth)) : with_third(sampler.get<2>(light_set(depth)));
       // One light sample: L * f * cos / pdf, weighted against BSDF sampling.
       Vec3 wi, emitted{0.0f};
       float light_pdf = 0.0f, distance = kInfinity;
@@ -136,9 +161,8 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
         if (!occluded_leaving(accel, shadow, sp.tri)) radiance += beta * f * light.power / d2;
       }
     }
-    const std::array<float, 3> bu = sampler.get<3>(bsdf_set(depth));
     BsdfSample bs;
-    if (!bsdf.sample(wo, bu[2], bu[0], bu[1], bs)) break;
+    if (!sample_bsdf(bsdf, wo, sampler, bsdf_set(depth), bs)) break;
     // The shading normal may send a reflection through the geometric surface (or a refraction
     // back out): such a sample has no consistent meaning, so the path ends.
     if ((dot(bs.wi, sp.n) < 0.0f) != bs.transmitted) break;

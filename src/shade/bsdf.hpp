@@ -56,6 +56,8 @@ class Bsdf {
 
   Kind kind() const { return kind_; }
   bool delta() const { return kind_ != Kind::Smooth; }
+  // A smooth BSDF with both a diffuse and a glossy lobe: sample() then reads u_lobe.
+  bool two_lobes() const { return kind_ == Kind::Smooth && p_glossy_ > 0.0f && p_glossy_ < 1.0f; }
 
   Vec3 eval(Vec3 wo_world, Vec3 wi_world) const {
     if (kind_ != Kind::Smooth) return Vec3{0.0f};
