@@ -7,9 +7,13 @@
 # 35 for the sky-lit Sponza on this machine.
 #   scripts/benchmarks-noise.sh [SCENE ...]    scenes: cornell-original cornell-water sponza-sky
 #   TRACER=path/to/tracer scripts/benchmarks-noise.sh ...   another build (an older commit's)
-# Writes docs/bench/noise-SCENE.md (or noise-SCENE-LABEL.md with LABEL=...).
+#   SIZE=256 scripts/benchmarks-noise.sh ...   a smaller image (a quarter of the time; RMSE per pixel
+#                                              barely moves with the size)
+# Writes docs/bench/noise-SCENE.md (or noise-SCENE-SIZE.md for another SIZE, -LABEL with LABEL=...).
 source "$(dirname "$0")/bench-prelude.sh"
+size=${SIZE:-512}
 label=${LABEL:+-$LABEL}
+[[ $size == 512 ]] || label="-$size$label"
 scenes=("$@")
 [[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell-original cornell-water sponza-sky)
 work=$(mktemp -d)
@@ -30,7 +34,7 @@ for scene in "${scenes[@]}"; do
     sponza-sky) flags=(--view sponza --env 1,1,1 --no-scene-lights) ;;
     *) echo "unknown scene $scene" >&2; exit 2 ;;
   esac
-  common=("${flags[@]}" --integrator path --width 512 --height 512 --threads 2 -q)
+  common=("${flags[@]}" --integrator path --width "$size" --height "$size" --threads 2 -q)
   $T render "${common[@]}" --spp 4096 --seed 99 -o "$work/ref.png"
   rows=()
   for spp in 16 32 64 128 256 512 1024; do
@@ -39,13 +43,13 @@ for scene in "${scenes[@]}"; do
     rmse=$($T compare "$work/ref.png" "$work/img.png" | sed -E 's/.*RMSE ([^,]*),.*/\1/')
     rows+=("$spp $ms $rmse")
   done
-  printf '%s\n' "${rows[@]}" | awk -v scene="$scene" -v tracer="$($T --version 2>/dev/null | head -1)" '
+  printf '%s\n' "${rows[@]}" | awk -v scene="$scene" -v size="$size" -v tracer="$($T --version 2>/dev/null | head -1)" '
     { spp[NR] = $1; s[NR] = $2 / 1000; e[NR] = $3; n = NR }
     END {
-      printf "%s, 512x512, path, 2 threads (%s); RMSE of the displayed values (tone-mapped, 8-bit, in [0, 1]) against 4096 spp (seed 99)\n\n", scene, tracer
+      printf "%s, %dx%d, path, 2 threads (%s); RMSE of the displayed values (tone-mapped, 8-bit, in [0, 1]) against 4096 spp (seed 99)\n\n", scene, size, size, tracer
       print "| spp | render s | Msamples/s | RMSE |"
       print "|---:|---:|---:|---:|"
-      for (i = 1; i <= n; ++i) printf "| %d | %.2f | %.3f | %.5f |\n", spp[i], s[i], 512 * 512 * spp[i] / s[i] / 1e6, e[i]
+      for (i = 1; i <= n; ++i) printf "| %d | %.2f | %.3f | %.5f |\n", spp[i], s[i], size * size * spp[i] / s[i] / 1e6, e[i]
       for (i = 1; i <= n; ++i) { if (spp[i] == 16) a = i; if (spp[i] == 256) b = i }
       printf "\nslope of RMSE against spp, 16 to 256: N^%.3f\n\n", log(e[b] / e[a]) / log(spp[b] / spp[a])
       print "| RMSE | seconds to reach it |"
