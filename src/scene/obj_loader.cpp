@@ -20,6 +20,17 @@
 namespace tracer {
 namespace {
 
+// Two names per material, in material order: its map_Kd, its map_bump ("" where none).
+std::vector<std::string> texture_names(const std::vector<MtlMaterial>& materials) {
+  std::vector<std::string> names;
+  names.reserve(2 * materials.size());
+  for (const MtlMaterial& m : materials) {
+    names.push_back(m.diffuse_map);
+    names.push_back(m.bump_map);
+  }
+  return names;
+}
+
 namespace fs = std::filesystem;
 
 // Resolves `mtllib` names: from files beside the OBJ (each read once, like the OBJ), or from one
@@ -48,8 +59,8 @@ class MtlSource {
   }
 
   // Reads the MTL files of the OBJ's `mtllib` statements (each a list of names, of which the first
-  // that reads is used) before the OBJ is parsed, and returns the diffuse texture names of the
-  // materials they will give, in order: the textures can then be read while the geometry is
+  // that reads is used) before the OBJ is parsed, and returns the texture names of the materials
+  // they will give, in order (texture_names()): the textures can then be read while the geometry is
   // parsed. The prediction is checked against what the parse gives (load()), so it only ever
   // saves time.
   std::vector<std::string> prefetch(const std::vector<std::vector<std::string>>& statements) {
@@ -62,10 +73,8 @@ class MtlSource {
         if (r.error) return texnames;  // the load stops there
         if (!r.ok) continue;
         loaded.insert(n);
-        for (const MtlMaterial& m : r.materials) {
-          texnames.push_back(m.diffuse_map);
-          texnames.push_back(m.bump_map);
-        }
+        const std::vector<std::string> mine = texture_names(r.materials);
+        texnames.insert(texnames.end(), mine.begin(), mine.end());
         break;
       }
     }
@@ -265,17 +274,6 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
   throw_if_cancelled(cancel);
   t.texnames = std::move(texnames);
   return t;
-}
-
-// Two names per material, in material order: its map_Kd, its map_bump ("" where none).
-std::vector<std::string> texture_names(const std::vector<MtlMaterial>& materials) {
-  std::vector<std::string> names;
-  names.reserve(2 * materials.size());
-  for (const MtlMaterial& m : materials) {
-    names.push_back(m.diffuse_map);
-    names.push_back(m.bump_map);
-  }
-  return names;
 }
 
 // What the statements of an OBJ make of its triangles: the materials its `mtllib` files define (in
