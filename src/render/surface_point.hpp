@@ -59,6 +59,12 @@ inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
   return dot(unit, n) < 0.0f ? -unit : unit;
 }
 
+// The texture coordinates at a hit, interpolated from its triangle's corners `c`.
+inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
+  const float w = 1.0f - hit.u - hit.v;
+  return {c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, c[0].y * w + c[1].y * hit.u + c[2].y * hit.v};
+}
+
 // The shading normal `ns` moved by the material's bump map, as pbrt's bump mapping does: the
 // surface displaced along ns by bump_multiplier * height(u, v) in scene units, whose tangents are
 // dp/du + ns dh/du and dp/dv + ns dh/dv (dp/du, dp/dv from the triangle's positions and texture
@@ -75,8 +81,7 @@ inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& ma
   const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
   const Vec3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0f / det), dpdv = (e2 * du1 - e1 * du2) * (1.0f / det);
   const Texture& t = scene.textures[mat.bump_texture];
-  const float w = 1.0f - hit.u - hit.v;
-  const float u = c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, v = c[0].y * w + c[1].y * hit.u + c[2].y * hit.v;
+  const auto [u, v] = hit_uv(c, hit);
   const float hu = 0.5f / float(t.width()), hv = 0.5f / float(t.height());
   const float dhdu = (t.height(u + hu, v) - t.height(u - hu, v)) / (2.0f * hu) * mat.bump_multiplier;
   const float dhdv = (t.height(u, v + hv) - t.height(u, v - hv)) / (2.0f * hv) * mat.bump_multiplier;
@@ -122,9 +127,7 @@ inline float texture_lod(const Scene& scene, const Hit& hit, const Texture& t, f
 inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat, const RayCone& cone = {},
                           float cos_incidence = 1.0f) {
   if (mat.diffuse_texture == kInvalidIndex || scene.corner_uvs.empty()) return mat.kd;
-  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
-  const float w = 1.0f - hit.u - hit.v;
-  const float u = c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, v = c[0].y * w + c[1].y * hit.u + c[2].y * hit.v;
+  const auto [u, v] = hit_uv(&scene.corner_uvs[3 * size_t(hit.tri)], hit);
   const Texture& t = scene.textures[mat.diffuse_texture];
   if (!cone.active()) return t.bilinear(u, v);
   return t.filtered(u, v, texture_lod(scene, hit, t, cone.width_at(hit.t), cos_incidence));
