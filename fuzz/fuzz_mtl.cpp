@@ -1,16 +1,24 @@
 // libFuzzer target for the MTL path: the input is an MTL file that a fixed one-triangle OBJ
 // names and uses. Loading must either succeed with finite materials, every triangle's material
-// in range, or throw InputError; anything else (crash, leak, other exception) is a finding.
+// in range, or throw InputError; anything else (crash, leak, other exception) is a finding. And
+// the parser must read the input as tinyobjloader does (tests/oracle/mtl_oracle.hpp).
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include "base/errors.hpp"
+#include "oracle/mtl_oracle.hpp"
 #include "scene/obj_loader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string mtl(reinterpret_cast<const char*>(data), size);
+  if (const std::optional<std::string> d = tracer::oracle::mtl_disagreement(mtl)) {
+    std::fprintf(stderr, "tracer and tinyobjloader disagree: %s\n", d->c_str());
+    std::abort();
+  }
   // The OBJ uses the first material name the input defines, so the material is really applied.
   std::string used = "m";
   if (const size_t at = mtl.find("newmtl "); at != std::string::npos) {

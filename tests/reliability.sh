@@ -21,6 +21,10 @@ printf 'mtllib grey.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n' 
 printf 'newmtl  Lamp\nKd 0.5\nKe 1\n' > grey.mtl
 printf 'mtllib kdnan.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > kdnan.obj
 printf 'newmtl a\nKd nan 0 0\n' > kdnan.mtl
+printf 'mtllib real.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > real.obj
+printf 'newmtl a\nTr 0  0\nTr 0  illum 2\nKa 0.0000 0.0000 0.0000c\nKd 0.5 0.5 0.5\nmap_Kd -o 0.5 0.5 -s 2 2 none.png\n' > real.mtl
+printf 'mtllib notmtl.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > notmtl.obj
+cp notmtl.obj notmtl.mtl
 printf 'v -1e13 -1e13 0\nv 1e13 -1e13 0\nv 0 1e13 0\nf 1 2 3\n' > huge.obj
 printf 'mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > zero.obj
 ln -s /dev/zero zero.mtl
@@ -155,6 +159,8 @@ cases=(
   "--fov 1e-30 with Embree|tracer render --fov 1e-30 --accel embree -q|2"
   "a triangle beyond +-1e12|tracer render huge.obj -q --integrator ao --ao 0|1"
   "Kd nan in the MTL|tracer render kdnan.obj -q|1"
+  "a real exporter's MTL: Tr 0  0, Tr 0  illum 2, 0.0000c, -o and -s of two values|tracer render real.obj --width 8 --height 8 -o r.png|0"
+  "mtllib names a file that is no MTL|tracer render notmtl.obj --width 8 --height 8 -o n.png|0"
   "Kd 0.5 (one value: grey), newmtl with two spaces|tracer render grey.obj -q --width 8 --height 8 -o g.png|0"
   "the only emitter out of view|tracer render dark.obj -q --width 8 --height 8 --spp 2 --eye 0,0,3 --look 0,0,0 -o d.png|0"
   "an empty scene name|tracer render '' -q|2"

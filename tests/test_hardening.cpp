@@ -1,6 +1,6 @@
 // Hostile inputs and outputs (docs/RELIABILITY.md): outputs that are device nodes, FIFOs,
-// symbolic links or inputs; coordinates at the edge of the accepted range; MTL values; inputs
-// that never end; texture decompression bombs; black images; anti-aliasing for every integrator.
+// symbolic links or inputs; coordinates at the edge of the accepted range; inputs that never end;
+// texture decompression bombs; black images; anti-aliasing for every integrator.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -14,7 +14,6 @@
 
 #include "base/errors.hpp"
 #include "parallel/executor.hpp"
-#include "scene/mtl_parser.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/texture.hpp"
 #include "test_util.hpp"
@@ -149,72 +148,6 @@ TEST_F(Hardening, ANarrowFovThatBacksTheCameraOutOfRangeIsRefused) {
     r = test::run_tracer("render -q --fov 1e-30 --accel " + std::string(accel) + " -o " + in("w.png"));
     EXPECT_EQ(r.exit_code, 2) << r.output;
   }
-}
-
-TEST(MtlParser, ReadsEveryNumericStatementAsTheFormatSays) {
-  const std::vector<MtlMaterial> m = parse_mtl(
-      "# comment\nnewmtl  Grey\t\nKd 0.5\nKs 0.1 0.2 0.3\nKe 17 12 4# glued comment\nNs 10\nNi 1.5\nd 0.25\n"
-      "Tr 0.5\nillum 7\nmap_Kd -s 1 1 1 -o 0.5 0.5 my texture.png\nbump -bm 0.3 height.png\n"
-      "newmtl Glass\nTf 0.9\nKd xyz 0.95047 1 1.08883\n",
-      "t.mtl");
-  ASSERT_EQ(m.size(), 2u);
-  EXPECT_EQ(m[0].name, "Grey");
-  EXPECT_EQ(m[0].kd, Vec3(0.5f));
-  EXPECT_EQ(m[0].ks, (Vec3{0.1f, 0.2f, 0.3f}));
-  EXPECT_EQ(m[0].ke, (Vec3{17.0f, 12.0f, 4.0f}));
-  EXPECT_EQ(m[0].ns, 10.0f);
-  EXPECT_EQ(m[0].ni, 1.5f);
-  EXPECT_EQ(m[0].dissolve, 0.25f);  // d wins over Tr
-  EXPECT_EQ(m[0].illum, 7);
-  EXPECT_EQ(m[0].diffuse_map, "my texture.png");
-  EXPECT_EQ(m[0].bump_map, "height.png");
-  EXPECT_FLOAT_EQ(m[0].bump_multiplier, 0.3f);
-  EXPECT_EQ(m[1].tf, Vec3(0.9f));
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(m[1].kd[i], 1.0f, 2e-3f);  // D65 white is RGB white
-}
-
-TEST(MtlParser, BadValuesAreErrorsWithFileAndLine) {
-  const std::pair<const char*, const char*> cases[] = {
-      {"Kd nan", "t.mtl:2: 'Kd' value 'nan' is not a finite number"},
-      {"Kd red green blue", "t.mtl:2: malformed number 'red'"},
-      {"Ke nan", "t.mtl:2: 'Ke' value 'nan' is not a finite number"},
-      {"Ke 3e38", "t.mtl:2: 'Ke' value '3e38' out of range [0, 1e+06]"},
-      {"Kd 1e308", "t.mtl:2: 'Kd' value '1e308' out of range [0, 1]"},
-      {"Kd 1e999", "t.mtl:2: 'Kd' value '1e999' is not a finite number"},
-      {"Kd -0.5", "t.mtl:2: 'Kd' value '-0.5' out of range [0, 1]"},
-      {"Kd 0.5 0.5", "t.mtl:2: 'Kd' needs one value or three, got two"},
-      {"Kd 0.1 0.2 0.3 0.4", "t.mtl:2: 'Kd' has more than three values"},
-      {"Kd", "t.mtl:2: 'Kd' needs a number"},
-      {"Kd spectral a.rfl", "t.mtl:2: 'Kd spectral' is not supported"},
-      {"Ns -1", "t.mtl:2: 'Ns' value '-1' out of range"},
-      {"Ni 1e3", "t.mtl:2: 'Ni' value '1e3' out of range [0, 100]"},
-      {"d 2", "t.mtl:2: 'd' value '2' out of range [0, 1]"},
-      {"illum 2.5", "t.mtl:2: 'illum' takes a whole number from 0 to 10"},
-      {"illum 11", "t.mtl:2: 'illum' value '11' out of range [0, 10]"},
-      {"Ns 1 2", "t.mtl:2: 'Ns' has an extra value '2'"},
-      {"map_Kd", "t.mtl:2: 'map_Kd' needs a file name"},
-      {"map_Kd -clamp", "t.mtl:2: 'map_Kd' option '-clamp' needs a value"},
-  };
-  for (const auto& [line, message] : cases) {
-    SCOPED_TRACE(line);
-    try {
-      parse_mtl(std::string("newmtl m\n") + line + "\n", "t.mtl");
-      ADD_FAILURE() << "no error";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
-    }
-  }
-  EXPECT_THROW(parse_mtl("Kd 1 1 1\n", "t.mtl"), InputError);  // before any newmtl
-}
-
-TEST(MtlParser, OneValueIsGreyAndTwoSpacesStillNameTheMaterial) {
-  const Scene s = load_obj_from_string("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n",
-                                       "newmtl  Lamp\nKd 0.5\nKe 2\n", "m.obj");
-  ASSERT_EQ(s.materials.size(), 1u);
-  EXPECT_EQ(s.materials[s.tri_material[0]].name, "Lamp");
-  EXPECT_EQ(s.materials[0].kd, Vec3(0.5f));
-  EXPECT_EQ(s.materials[0].ke, Vec3(2.0f));
-  EXPECT_EQ(s.lights.size(), 1u);
 }
 
 TEST_F(Hardening, InputsThatNeverEndStopAtTheirLimit) {

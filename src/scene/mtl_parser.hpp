@@ -1,7 +1,12 @@
-// The MTL format (Wavefront's material library), read strictly: every numeric statement as the
-// format defines it (`Kd r [g b]`, one value meaning grey), every value range-checked, and any
-// malformed or out-of-range value an error naming file:line. Tokens are separated by any run of
-// spaces and tabs; `#` starts a comment anywhere on a line (exporters glue them to numbers).
+// The MTL format (Wavefront's material library), read as tinyobjloader reads the files of real
+// exporters, and strictly where a value would make the image wrong. Liberal: letters glued to a
+// number (`0.5c`), text after what a statement takes (`Tr 0  illum 2`), statements before the
+// first `newmtl` and unknown texture options are dropped, each kind said once per file with its
+// lines. Strict, an error naming file:line: no number where one is required (`Kd red`), two
+// values of a colour, nan, inf, values out of range. Tokens are separated by any run of spaces and
+// tabs; `#` starts a comment anywhere on a line (exporters glue them to numbers). Where tracer
+// reads a file otherwise than tinyobjloader, docs/RELIABILITY.md says why (the differential test
+// in tests/test_mtl_differential.cpp holds the rest equal).
 #pragma once
 
 #include <string>
@@ -32,9 +37,15 @@ inline constexpr float kMaxEmission = 1e6f;     // Ke: radiance, far above any r
 inline constexpr float kMaxShininess = 1e6f;    // Ns
 inline constexpr float kMaxIor = 100.0f;        // Ni (0 is accepted: exporters write it for "unset")
 
+// The materials of one file, and its warnings: each one line that names the file and the lines.
+struct MtlFile {
+  std::vector<MtlMaterial> materials;
+  std::vector<std::string> warnings;
+};
+
 // Parses MTL text; `name` stands for the file in messages. Throws InputError("name:line: ...").
 // Statements the renderer does not use (map_Ks, Pr, ...) are skipped; a spectral colour
 // (`Kd spectral file.rfl`) is an error, as tracer renders RGB.
-std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name, CancelFlag cancel = nullptr);
+MtlFile parse_mtl(std::string_view text, const std::string& name, CancelFlag cancel = nullptr);
 
 }  // namespace tracer

@@ -47,7 +47,7 @@ class MtlSource {
   struct MtlRead {
     bool ok = false;
     std::string warn;
-    std::vector<MtlMaterial> materials;
+    MtlFile file;
     std::exception_ptr error;
   };
 
@@ -73,7 +73,7 @@ class MtlSource {
         if (r.error) return texnames;  // the load stops there
         if (!r.ok) continue;
         loaded.insert(n);
-        const std::vector<std::string> mine = texture_names(r.materials);
+        const std::vector<std::string> mine = texture_names(r.file.materials);
         texnames.insert(texnames.end(), mine.begin(), mine.end());
         break;
       }
@@ -105,7 +105,7 @@ class MtlSource {
         }
       }
       strip_bom(text);
-      r.materials = parse_mtl(text, name, cancel_);
+      r.file = parse_mtl(text, name, cancel_);
       r.ok = true;
     } catch (...) {
       r.error = std::current_exception();
@@ -336,7 +336,8 @@ Layout lay_out(const ObjGeometry& obj, MtlSource& mtl, WarningLog& warnings) {
           if (!r.warn.empty()) warnings.add(r.warn);
           if (!r.ok) continue;
           loaded.insert(n);
-          for (const MtlMaterial& m : r.materials) {
+          for (const std::string& w : r.file.warnings) warnings.add(w);
+          for (const MtlMaterial& m : r.file.materials) {
             by_name.try_emplace(m.name, static_cast<uint32_t>(out.materials.size()));  // the first of a name wins
             out.materials.push_back(m);
           }
