@@ -297,6 +297,14 @@ void ObjGeometry::Chunk::parse_line(std::string_view rest, const std::string& na
                                     uint64_t line, uint64_t local_line) {
   rest = trim(rest);
   if (rest.empty() || rest.front() == '#') return;
+  // A comment after the values (`v 1 2 3 # note`), as tinyobjloader reads a `v` line; a `#`
+  // glued to a value stays part of it (`3#x` is no index).
+  for (size_t at = rest.find('#'); at != std::string_view::npos; at = rest.find('#', at + 1)) {
+    if (is_blank(rest[at - 1])) {
+      rest = trim(rest.substr(0, at));
+      break;
+    }
+  }
   const std::string_view keyword = next_token(rest);
   if (keyword == "v" || keyword == "vn" || keyword == "vt") {
     const size_t needed = keyword == "vt" ? 1 : 3;
