@@ -52,6 +52,7 @@ TEST(MtlParser, BadValuesAreErrorsWithFileAndLine) {
       {"Kd red green blue", "t.mtl:2: malformed number 'red'"},
       {"Kd 1e", "t.mtl:2: malformed number '1e'"},
       {"Kd .", "t.mtl:2: malformed number '.'"},
+      {"Kd 0.7 00.6ewmt 4", "t.mtl:2: malformed number '00.6ewmt'"},
       {"Ke nan", "t.mtl:2: 'Ke' value 'nan' is not a finite number"},
       {"Ke 3e38", "t.mtl:2: 'Ke' value '3e38' out of range [0, 1e+06]"},
       {"Kd 1e308", "t.mtl:2: 'Kd' value '1e308' out of range [0, 1]"},

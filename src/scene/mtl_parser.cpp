@@ -14,8 +14,14 @@ namespace {
   throw InputError(name + ":" + std::to_string(line) + ": " + what);
 }
 
-// Whether a token starts a number (or spells a non-finite one, which number() then refuses).
-bool starts_number(std::string_view tok) { return number_prefix_length(tok) > 0 || is_non_finite_word(tok); }
+// Whether a token begins as a number does (a sign, a point, a digit), or spells a non-finite one:
+// a colour's further values and an option's are read while tokens do, and number() refuses the
+// malformed ones (`1e`, `0.6ex`), which tinyobjloader would read as zero.
+bool starts_number(std::string_view tok) {
+  size_t i = !tok.empty() && (tok[0] == '+' || tok[0] == '-') ? 1 : 0;
+  if (i < tok.size() && tok[i] == '.') ++i;
+  return (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') || is_non_finite_word(tok);
+}
 
 // Lines whose statement had text after what it takes, and the lines before the first `newmtl`:
 // harmless in the files of real exporters, said once per file, with the lines.

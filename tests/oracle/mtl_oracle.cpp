@@ -51,14 +51,17 @@ std::string texture_as_the_format_means(const std::string& original, const std::
   size_t i = 1;
   while (i + 1 < w.size() && w[i].size() > 1 && w[i][0] == '-' && std::isalpha(static_cast<unsigned char>(w[i][1]))) {
     const std::string option = w[i++];
+    static const char* kKnown[] = {"-o",     "-s",       "-t",    "-mm",     "-bm",    "-blendu",    "-blendv",
+                                   "-clamp", "-imfchan", "-type", "-texres", "-boost", "-colorspace"};
+    if (std::find(std::begin(kKnown), std::end(kKnown), option) == std::end(kKnown)) {
+      if (option == "-cc" || i + 1 < w.size()) ++i;  // tracer skips its one value, if a file name follows
+      continue;
+    }
     const bool counted = option == "-o" || option == "-s" || option == "-t" || option == "-mm";
     std::vector<std::string> values{w[i++]};
     const size_t most = option == "-mm" ? 2 : 3;
     while (counted && values.size() < most && i + 1 < w.size() && begins_number(w[i])) values.push_back(w[i++]);
     while (counted && values.size() < most) values.push_back("1");
-    static const char* kKnown[] = {"-o",     "-s",       "-t",    "-mm",     "-bm",    "-blendu",    "-blendv",
-                                   "-clamp", "-imfchan", "-type", "-texres", "-boost", "-colorspace"};
-    if (std::find(std::begin(kKnown), std::end(kKnown), option) == std::end(kKnown)) continue;
     line += " " + option;
     for (const std::string& v : values) line += " " + v;
   }
