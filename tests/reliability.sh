@@ -34,6 +34,12 @@ printf 'mtllib bomb.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > bo
 printf 'newmtl a\nmap_Kd bomb.png\n' > bomb.mtl
 # A PNG header claiming 16384 x 16384 texels (IHDR and its CRC), and nothing more.
 printf '\211PNG\r\n\032\n\000\000\000\rIHDR\000\000\100\000\000\000\100\000\010\002\000\000\000\046\252\207\323' > bomb.png
+# Environment maps: a header claiming the largest map with 40 bytes behind it, and a whole
+# 16256 x 8192 map (every scanline 128 runs of 127 texels a channel: 8 MB) to interrupt.
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16384\n'; head -c 40 /dev/zero; } > claim.hdr
+{ printf '\002\002\077\200'; for i in $(seq 512); do printf '\377\200'; done; } > rows.bin
+for i in $(seq 13); do cat rows.bin rows.bin > rows2.bin && mv rows2.bin rows.bin; done
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16256\n'; cat rows.bin; } > big.hdr && rm rows.bin
 mkdir viewsdir
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > viewsdir/tri.obj
 printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\ttri.obj\t0,0,3\t0,0\n' > viewsdir/views.tsv
@@ -158,6 +164,10 @@ cases=(
   "bench --plot is the scene|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes ok.obj --plot ok.obj|2"
   "--fov 1e-30 with Embree|tracer render --fov 1e-30 --accel embree -q|2"
   "a triangle beyond +-1e12|tracer render huge.obj -q --integrator ao --ao 0|1"
+  "--env-rotation 1e300 with --env-map|tracer render --integrator path --env-map big.hdr --env-rotation 1e300 -q|2"
+  "an .hdr header claiming 16384x8192 texels, 40 bytes of pixels|tracer render --integrator path --env-map claim.hdr -q|1"
+  "Ctrl-C while a 16256x8192 environment map decodes|timeout --foreground --preserve-status -s INT 1 tracer render --integrator path --env-map big.hdr -q|130"
+  "a sky of 1e30 seen directly, into a half EXR|tracer render --integrator path --env 1e30,1e30,1e30 --spp 1 --width 8 --height 8 -o sky.exr|0"
   "Kd nan in the MTL|tracer render kdnan.obj -q|1"
   "a real exporter's MTL: Tr 0  0, Tr 0  illum 2, 0.0000c, -o and -s of two values|tracer render real.obj --width 8 --height 8 -o r.png|0"
   "mtllib names a file that is no MTL|tracer render notmtl.obj --width 8 --height 8 -o n.png|0"

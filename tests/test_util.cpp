@@ -36,8 +36,10 @@ std::vector<Ray> random_rays(const Scene& scene, size_t count, uint32_t seed) {
   return rays;
 }
 
-CommandResult run_tracer(const std::string& args) {
-  const std::string cmd = std::string(TRACER_EXE) + " " + args + " 2>&1";
+CommandResult run_tracer(const std::string& args) { return run_shell(std::string(TRACER_EXE) + " " + args); }
+
+CommandResult run_shell(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   CommandResult result{-1, ""};
   if (!pipe) return result;

@@ -26,6 +26,8 @@ struct CommandResult {
 };
 // Runs the tracer binary with `args` (shell-quoted by the caller).
 CommandResult run_tracer(const std::string& args);
+// A shell command (sh -c), its stdout and stderr together.
+CommandResult run_shell(const std::string& command);
 
 // A scene of loose triangles, one geometry, default material, finalized.
 Scene scene_of(const std::vector<Triangle>& tris);

@@ -128,6 +128,7 @@ void validate(const RenderArgs& a) {
   if (a.spp) check_range("--spp", *a.spp, 1, 1 << 20);
   check_range("--frames", a.frames, 1, 1'000'000);
   check_range_real("--orbit", a.orbit, -1e6, 1e6);
+  check_range_real("--env-rotation", a.scene.env_rotation, -1e6, 1e6);
   if (a.checkpoint) check_range_real("--checkpoint", *a.checkpoint, 0.0, 1e9, true);
   if (!a.env.empty()) {
     const Vec3 env = parse_vec3("--env", a.env);
@@ -206,10 +207,26 @@ void add_lights(Scene& scene, const SceneArgs& a) {
   }
 }
 
-// --env-map: read once the scene is known good, so a bad scene is reported first.
-void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel) {
-  if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation: expected a finite number of degrees");
-  if (!a.env_map.empty()) scene.environment_map = load_environment_map(a.env_map, float(a.env_rotation), cancel);
+// --env-map: read once the scene is known good, so a bad scene is reported first. What the map
+// holds that cannot light the scene as written is said, once each.
+void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel, const WarningSink& warn) {
+  check_range_real("--env-rotation", a.env_rotation, -1e6, 1e6);
+  if (a.env_map.empty()) return;
+  scene.environment_map = load_environment_map(a.env_map, a.env_rotation, cancel);
+  const EnvironmentMap& map = scene.environment_map;
+  const auto say = [&](const std::string& what) {
+    if (warn)
+      warn(a.env_map + ": " + what);
+    else
+      std::cerr << "tracer: warning: " << a.env_map << ": " << what << "\n";
+  };
+  if (map.zeroed_values() > 0) {
+    say(std::to_string(map.zeroed_values()) + " texel values negative or not finite, read as 0");
+  }
+  if (map.clamped_values() > 0) {
+    say(std::to_string(map.clamped_values()) + " texel values above 1e30, read as 1e30");
+  }
+  if (map.black()) say("the environment map is black: it lights nothing");
 }
 
 }  // namespace
@@ -238,7 +255,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     apply_view_light(scene, view);
     scene.camera = view.camera;
     add_lights(scene, a);
-    add_environment(scene, a, cancel);
+    add_environment(scene, a, cancel, warn);
     return scene;
   }
   Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
@@ -261,7 +278,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     }
   }
   add_lights(scene, a);
-  add_environment(scene, a, cancel);
+  add_environment(scene, a, cancel, warn);
   return scene;
 }
 

@@ -21,7 +21,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
                          const RenderRound& render_round, const std::function<void(const std::string&)>& warn) {
   using Clock = std::chrono::steady_clock;
   DriveResult result;
-  bool warned_black = false;
+  bool warned_black = false, warned_clamped = false;
   for (int frame = 0; frame < seq.frames; ++frame) {
     const std::string output = frame_output(seq.output, frame, seq.frames);
     std::optional<Framebuffer> fb, albedo, normal;
@@ -35,7 +35,16 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     std::vector<ExrLayer> layers;
     if (albedo) layers.push_back({"albedo", &*albedo, {"R", "G", "B"}});
     if (normal) layers.push_back({"normal", &*normal, {"X", "Y", "Z"}});
-    const auto write = [&] { write_render(output, *fb, settings.exposure, seq.exr, layers); };
+    const auto write = [&] {
+      const size_t clamped = write_render(output, *fb, settings.exposure, seq.exr, layers);
+      if (clamped > 0 && !warned_clamped) {
+        warn(output + ": " + std::to_string(clamped) + " pixel values beyond the " +
+             (seq.exr == ExrPixel::Half ? "half EXR's range (65504; --exr float holds up to 3.4e38)"
+                                        : "float EXR's range") +
+             " or not finite, written as its largest value");
+        warned_clamped = true;
+      }
+    };
     auto last_write = Clock::now();
     uint32_t done = 0;
     for (const std::vector<SampleRange>& round : rounds_of(settings, round_per_pass)) {

@@ -5,7 +5,6 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfStdIO.h>
-#include <stb_image.h>
 
 #include <algorithm>
 #include <cctype>
@@ -13,6 +12,7 @@
 #include <memory>
 
 #include "base/read_input.hpp"
+#include "io/rgbe_decode.hpp"
 
 namespace tracer {
 
@@ -26,7 +26,7 @@ void check_size(const std::string& path, long long w, long long h) {
   }
 }
 
-EnvironmentMap read_exr_map(const std::string& path, float rotation, CancelFlag cancel) {
+EnvironmentMap read_exr_map(const std::string& path, double rotation, CancelFlag cancel) {
   // Read whole first (an input like any other: its identity remembered, a FIFO cancellable).
   Imf::StdISStream stream;
   stream.str(read_input(path, cancel, kMaxEnvironmentTexels * 16 + (uint64_t(1) << 20)));
@@ -39,20 +39,23 @@ EnvironmentMap read_exr_map(const std::string& path, float rotation, CancelFlag 
         !file.header().channels().findChannel("B")) {
       throw InputError(path + ": an environment map needs R, G and B channels");
     }
-    std::vector<float> planes(3 * size_t(w) * size_t(h));
+    // Nothing is allocated for pixels the file does not hold (a header alone claims any size).
+    if (!file.isComplete()) throw InputError(path + ": truncated: the file ends before its pixels do");
+    std::vector<Vec3> texels(size_t(w) * size_t(h));
     Imf::FrameBuffer frame;
     const char* names[3] = {"R", "G", "B"};
     for (int c = 0; c < 3; ++c) {
-      char* base = reinterpret_cast<char*>(planes.data() + size_t(c) * size_t(w) * size_t(h));
-      base -= (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));
-      frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+      char* base = reinterpret_cast<char*>(texels.data()) + size_t(c) * sizeof(float);
+      base -= (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(Vec3));
+      frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(Vec3), sizeof(Vec3) * size_t(w)));
     }
     file.setFrameBuffer(frame);
-    file.readPixels(window.min.y, window.max.y);
-    const size_t n = size_t(w) * size_t(h);
-    std::vector<Vec3> texels(n);
-    for (size_t i = 0; i < n; ++i) texels[i] = {planes[i], planes[n + i], planes[2 * n + i]};
-    return EnvironmentMap(int(w), int(h), std::move(texels), rotation);
+    // In bands of rows, so Ctrl-C is seen while a large map decodes.
+    for (int y = window.min.y; y <= window.max.y; y += 64) {
+      throw_if_cancelled(cancel);
+      file.readPixels(y, std::min(y + 63, window.max.y));
+    }
+    return EnvironmentMap(int(w), int(h), std::move(texels), rotation, cancel);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -60,27 +63,15 @@ EnvironmentMap read_exr_map(const std::string& path, float rotation, CancelFlag 
   }
 }
 
-EnvironmentMap read_hdr_map(const std::string& path, float rotation, CancelFlag cancel) {
+EnvironmentMap read_hdr_map(const std::string& path, double rotation, CancelFlag cancel) {
   const std::string bytes = read_input(path, cancel, kMaxEnvironmentTexels * 4 + (uint64_t(1) << 20));
-  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
-  const int size = int(std::min<size_t>(bytes.size(), size_t(INT32_MAX)));
-  int w = 0, h = 0, channels = 0;
-  if (!stbi_is_hdr_from_memory(data, size) || !stbi_info_from_memory(data, size, &w, &h, &channels)) {
-    throw InputError(path + ": cannot read environment map: not a Radiance HDR file");
-  }
-  check_size(path, w, h);
-  const std::unique_ptr<float, void (*)(void*)> pixels(stbi_loadf_from_memory(data, size, &w, &h, &channels, 3),
-                                                       stbi_image_free);
-  if (!pixels) throw InputError(path + ": cannot read environment map: " + stbi_failure_reason());
-  std::vector<Vec3> texels(size_t(w) * size_t(h));
-  for (size_t i = 0; i < texels.size(); ++i)
-    texels[i] = {pixels.get()[3 * i], pixels.get()[3 * i + 1], pixels.get()[3 * i + 2]};
-  return EnvironmentMap(w, h, std::move(texels), rotation);
+  RgbeImage image = decode_rgbe(bytes, path, check_size, cancel);
+  return EnvironmentMap(image.width, image.height, std::move(image.texels), rotation, cancel);
 }
 
 }  // namespace
 
-EnvironmentMap load_environment_map(const std::string& path, float rotation_degrees, CancelFlag cancel) {
+EnvironmentMap load_environment_map(const std::string& path, double rotation_degrees, CancelFlag cancel) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext == ".exr") return read_exr_map(path, rotation_degrees, cancel);

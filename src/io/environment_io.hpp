@@ -13,8 +13,10 @@ namespace tracer {
 // before anything is allocated.
 inline constexpr uint64_t kMaxEnvironmentTexels = uint64_t(16384) * 8192;
 
-// Throws InputError naming the file: unreadable, not EXR or HDR, too large, or too narrow for an
-// equirectangular map (at least 2 x 1 texels). `rotation_degrees` turns it about +y.
-EnvironmentMap load_environment_map(const std::string& path, float rotation_degrees, CancelFlag cancel = nullptr);
+// Throws InputError naming the file: unreadable, not EXR or HDR, too large, truncated, or too
+// narrow for an equirectangular map (at least 2 x 1 texels). `rotation_degrees` turns it about
+// +y. Memory follows the pixels the file holds, not the size its header claims; `cancel` is seen
+// while it decodes and while its sampling distribution is built.
+EnvironmentMap load_environment_map(const std::string& path, double rotation_degrees, CancelFlag cancel = nullptr);
 
 }  // namespace tracer

@@ -8,8 +8,11 @@
 #include <ImfOutputFile.h>
 #include <half.h>
 
+#include <cmath>
 #include <cstring>
 #include <exception>
+#include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "base/errors.hpp"
@@ -49,17 +52,26 @@ void add_channels(Imf::Header& header, Imf::FrameBuffer& frame, std::vector<T>& 
   }
 }
 
+// The image as three planes of T. A value beyond T's range (a half holds 65504 at most) or not
+// finite is written as the largest finite value of its sign (NaN as 0) and counted: no output
+// holds an infinity.
 template <class T>
-std::vector<T> planar(const Framebuffer& fb) {
+std::vector<T> planar(const Framebuffer& fb, size_t& clamped) {
+  const float largest = std::is_same_v<T, half> ? float(HALF_MAX) : std::numeric_limits<float>::max();
+  const auto finite = [&](float v) {
+    if (std::fabs(v) <= largest) return T(v);
+    ++clamped;
+    return T(std::isnan(v) ? 0.0f : std::copysign(largest, v));
+  };
   const size_t n = size_t(fb.width()) * size_t(fb.height());
   std::vector<T> planes(3 * n);
   for (int y = 0; y < fb.height(); ++y) {
     for (int x = 0; x < fb.width(); ++x) {
       const Vec3 p = fb.radiance(x, y);
       const size_t i = size_t(y) * size_t(fb.width()) + size_t(x);
-      planes[i] = T(p.x);
-      planes[n + i] = T(p.y);
-      planes[2 * n + i] = T(p.z);
+      planes[i] = finite(p.x);
+      planes[n + i] = finite(p.y);
+      planes[2 * n + i] = finite(p.z);
     }
   }
   return planes;
@@ -67,7 +79,8 @@ std::vector<T> planar(const Framebuffer& fb) {
 
 }  // namespace
 
-std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers) {
+std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers, size_t* clamped) {
+  size_t beyond = 0;
   try {
     Imf::Header header(fb.width(), fb.height());
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -81,10 +94,10 @@ std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<
       const std::array<const char*, 3> names =
           l == 0 ? std::array<const char*, 3>{"R", "G", "B"} : layers[l - 1].channels;
       if (pixel == ExrPixel::Half) {
-        halves[l] = planar<half>(image);
+        halves[l] = planar<half>(image, beyond);
         add_channels(header, frame, halves[l], fb.width(), fb.height(), Imf::HALF, prefix, names);
       } else {
-        floats[l] = planar<float>(image);
+        floats[l] = planar<float>(image, beyond);
         add_channels(header, frame, floats[l], fb.width(), fb.height(), Imf::FLOAT, prefix, names);
       }
     }
@@ -94,6 +107,7 @@ std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<
       file.setFrameBuffer(frame);
       file.writePixels(fb.height());
     }
+    if (clamped) *clamped = beyond;
     return stream.take();
   } catch (const std::exception& e) {
     throw InputError(std::string("EXR encoding failed: ") + e.what());

@@ -22,8 +22,10 @@ struct ExrLayer {
 };
 
 // The bytes of an EXR file holding `fb` (channels R, G, B, ZIP compression) and `layers`, all
-// of `pixel` type; throws InputError.
-std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers = {});
+// of `pixel` type; throws InputError. Values beyond the pixel type's range, or not finite, are
+// written as its largest finite value (NaN as 0); `*clamped` (if given) counts them.
+std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers = {},
+                       size_t* clamped = nullptr);
 
 // Reads an EXR's R, G, B channels as floats (tests, image comparison), or those of a layer
 // (NAME.R ... as encode_exr writes them); throws InputError.

@@ -201,13 +201,15 @@ void remove_pending_temp_file() {
   if (g_pending.load()) ::unlink(g_pending_temp);
 }
 
-void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel,
-                  const std::vector<ExrLayer>& layers) {
+size_t write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel,
+                    const std::vector<ExrLayer>& layers) {
+  size_t clamped = 0;
   if (image_format_for(path) == ImageFormat::Exr) {
-    write_file_atomic(path, encode_exr(fb, exr_pixel, layers));
+    write_file_atomic(path, encode_exr(fb, exr_pixel, layers, &clamped));
   } else {
     write_image(path, tonemap(fb, exposure));
   }
+  return clamped;
 }
 
 Image8 read_image(const std::string& path) {

@@ -25,9 +25,10 @@ void write_image(const std::string& path, const Image8& image);
 
 // Writes a render in the format the path names: PNG and PPM tone-mapped with `exposure`, EXR as
 // linear radiance (half or float), no tone mapping.
-// `layers` (AOVs) go into an EXR beside the radiance.
-void write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel,
-                  const std::vector<ExrLayer>& layers = {});
+// `layers` (AOVs) go into an EXR beside the radiance. Returns how many EXR values were beyond the
+// pixel type's range or not finite, and so written as its largest value (encode_exr).
+size_t write_render(const std::string& path, const Framebuffer& fb, float exposure, ExrPixel exr_pixel,
+                    const std::vector<ExrLayer>& layers = {});
 
 // Writes bytes to `path`. A regular file (or none) is replaced atomically through a temporary file
 // in its directory and a rename; a symbolic link is followed and its target replaced so; a device

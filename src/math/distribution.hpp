@@ -57,11 +57,15 @@ class Distribution1D {
 class Distribution2D {
  public:
   Distribution2D() = default;
-  // weights[y * width + x]: cell (x, y) of a width x height grid over [0, 1)^2.
-  Distribution2D(const std::vector<float>& weights, size_t width, size_t height) {
+  // weights[y * width + x]: cell (x, y) of a width x height grid over [0, 1)^2. `on_row(y)` is
+  // called before each row is built (a caller polls for cancellation there, and may throw).
+  template <class OnRow = void (*)(size_t)>
+  Distribution2D(
+      const std::vector<float>& weights, size_t width, size_t height, OnRow&& on_row = [](size_t) {}) {
     rows_.reserve(height);
     std::vector<float> row_integrals(height);
     for (size_t y = 0; y < height; ++y) {
+      on_row(y);
       rows_.emplace_back(weights.data() + y * width, width);
       row_integrals[y] = rows_.back().integral();
     }

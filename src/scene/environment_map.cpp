@@ -12,20 +12,37 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 }
 
-EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Vec3> texels, float rotation_degrees)
-    : width_(width), height_(height), rotation_(rotation_degrees / 360.0f), texels_(std::move(texels)) {
-  rotation_ -= std::floor(rotation_);
+EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Vec3> texels, double rotation_degrees,
+                               CancelFlag cancel)
+    : width_(width), height_(height), texels_(std::move(texels)) {
+  // Reduced in double, so a huge angle neither overflows a float nor loses the turn's fraction.
+  const double turns = std::isfinite(rotation_degrees) ? std::fmod(rotation_degrees, 360.0) / 360.0 : 0.0;
+  rotation_ = float(turns - std::floor(turns));
+  if (rotation_ >= 1.0f) rotation_ = 0.0f;
   std::vector<float> weights(texels_.size());
   for (int y = 0; y < height_; ++y) {
+    if ((y & 63) == 0) throw_if_cancelled(cancel);
     // The row's share of the sphere: sin(theta) at its centre (cells at the poles are small).
     const float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(height_));
     for (int x = 0; x < width_; ++x) {
       Vec3& t = texels_[size_t(y) * size_t(width_) + size_t(x)];
-      for (float* c : {&t.x, &t.y, &t.z}) *c = std::isfinite(*c) && *c > 0.0f ? *c : 0.0f;
-      weights[size_t(y) * size_t(width_) + size_t(x)] = luminance(t) * sin_theta;
+      for (float* c : {&t.x, &t.y, &t.z}) {
+        if (!(std::isfinite(*c) && *c >= 0.0f)) {
+          ++zeroed_;
+          *c = 0.0f;
+        } else if (*c > kMaxEnvironmentRadiance) {
+          ++clamped_;
+          *c = kMaxEnvironmentRadiance;
+        }
+      }
+      const float w = luminance(t) * sin_theta;
+      black_ = black_ && !(w > 0.0f);
+      weights[size_t(y) * size_t(width_) + size_t(x)] = w;
     }
   }
-  distribution_ = Distribution2D(weights, size_t(width_), size_t(height_));
+  distribution_ = Distribution2D(weights, size_t(width_), size_t(height_), [cancel](size_t y) {
+    if ((y & 63) == 0) throw_if_cancelled(cancel);
+  });
 }
 
 Vec2 EnvironmentMap::to_uv(Vec3 d) const {

@@ -8,18 +8,30 @@
 
 #include <vector>
 
+#include "base/errors.hpp"
 #include "math/distribution.hpp"
 #include "math/vec.hpp"
 
 namespace tracer {
 
+// The largest radiance a texel keeps (as --env's components): beyond it, products along a path
+// would overflow a float.
+inline constexpr float kMaxEnvironmentRadiance = 1e30f;
+
 class EnvironmentMap {
  public:
   EnvironmentMap() = default;
   // `texels`: width x height linear RGB, rows from the top (+y); negative or non-finite values
-  // become 0. `rotation_degrees` turns the map about +y.
-  EnvironmentMap(int width, int height, std::vector<Vec3> texels, float rotation_degrees = 0.0f);
+  // become 0, values above kMaxEnvironmentRadiance become it. `rotation_degrees` turns the map about
+  // +y (any finite angle). `cancel` is polled once a row while the sampling distribution is built.
+  EnvironmentMap(int width, int height, std::vector<Vec3> texels, double rotation_degrees = 0.0,
+                 CancelFlag cancel = nullptr);
   bool empty() const { return texels_.empty(); }
+  // Texel values that were negative or not finite (read as 0), or above kMaxEnvironmentRadiance.
+  size_t zeroed_values() const { return zeroed_; }
+  size_t clamped_values() const { return clamped_; }
+  // Whether no texel gives light: the map lights nothing.
+  bool black() const { return black_; }
   int width() const { return width_; }
   int height() const { return height_; }
   Vec3 radiance(Vec3 dir) const;
@@ -33,6 +45,8 @@ class EnvironmentMap {
   Vec3 from_uv(Vec2 uv) const;
   int width_ = 0, height_ = 0;
   float rotation_ = 0.0f;  // in turns
+  size_t zeroed_ = 0, clamped_ = 0;
+  bool black_ = true;
   std::vector<Vec3> texels_;
   Distribution2D distribution_;
 };
