@@ -40,6 +40,7 @@ printf '\211PNG\r\n\032\n\000\000\000\rIHDR\000\000\100\000\000\000\100\000\010\
 { printf '\002\002\077\200'; for i in $(seq 512); do printf '\377\200'; done; } > rows.bin
 for i in $(seq 13); do cat rows.bin rows.bin > rows2.bin && mv rows2.bin rows.bin; done
 { printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16256\n'; cat rows.bin; } > big.hdr && rm rows.bin
+"$tracer" render -q --integrator ao --ao 0 --width 2048 --height 1024 -o whole.exr && head -c 400 whole.exr > cut.exr && rm whole.exr
 mkdir viewsdir
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > viewsdir/tri.obj
 printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\ttri.obj\t0,0,3\t0,0\n' > viewsdir/views.tsv
@@ -168,6 +169,7 @@ cases=(
   "an .hdr header claiming 16384x8192 texels, 40 bytes of pixels|tracer render --integrator path --env-map claim.hdr -q|1"
   "Ctrl-C while a 16256x8192 environment map decodes|timeout --foreground --preserve-status -s INT 1 tracer render --integrator path --env-map big.hdr -q|130"
   "a sky of 1e30 seen directly, into a half EXR|tracer render --integrator path --env 1e30,1e30,1e30 --spp 1 --width 8 --height 8 -o sky.exr|0"
+  "compare: an EXR of 2048x1024 cut after 400 bytes|tracer compare cut.exr cut.exr|1"
   "Kd nan in the MTL|tracer render kdnan.obj -q|1"
   "a real exporter's MTL: Tr 0  0, Tr 0  illum 2, 0.0000c, -o and -s of two values|tracer render real.obj --width 8 --height 8 -o r.png|0"
   "mtllib names a file that is no MTL|tracer render notmtl.obj --width 8 --height 8 -o n.png|0"

@@ -1,6 +1,11 @@
 // The command line: every bad input's one-line error and exit code (1 input, 2 usage), and no
 // image left behind by a failed run.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
 #include <gtest/gtest.h>
+#include <half.h>
 
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -265,6 +270,40 @@ TEST_F(Cli, CtrlCDuringAPathRenderWritesTheSamplesSoFar) {
   EXPECT_EQ(img.height, 48);
 }
 
+// An EXR whose first pixel is NaN in every channel (encode_exr would write 0).
+void write_nan_exr(const std::string& path, const Framebuffer& fb) {
+  Imf::Header header(fb.width(), fb.height());
+  std::vector<float> planes(3 * size_t(fb.width()) * size_t(fb.height()));
+  Imf::FrameBuffer frame;
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    const size_t n = size_t(fb.width()) * size_t(fb.height());
+    for (size_t i = 0; i < n; ++i) planes[size_t(c) * n + i] = fb.radiance(int(i) % fb.width(), int(i) / fb.width())[c];
+    planes[size_t(c) * n] = std::numeric_limits<float>::quiet_NaN();
+    header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    frame.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(&planes[size_t(c) * n]), sizeof(float),
+                                      sizeof(float) * size_t(fb.width())));
+  }
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(frame);
+  file.writePixels(fb.height());
+}
+
+// An EXR of 4,000,000 x 1 pixels: larger than any image tracer writes.
+void write_wide_exr_header(const std::string& path) {
+  Imf::Header header(4000000, 1);
+  header.channels().insert("R", Imf::Channel(Imf::HALF));
+  header.channels().insert("G", Imf::Channel(Imf::HALF));
+  header.channels().insert("B", Imf::Channel(Imf::HALF));
+  std::vector<half> row(4000000);
+  Imf::FrameBuffer frame;
+  for (const char* c : {"R", "G", "B"})
+    frame.insert(c, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(row.data()), sizeof(half), 0));
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(frame);
+  file.writePixels(1);
+}
+
 TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   const std::string d = dir_ + "/";
   ASSERT_EQ(test::run_tracer("render -q --integrator path --spp 4 --width 8 --height 8 -o " + d + "a.exr").exit_code,
@@ -278,6 +317,19 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   auto r = test::run_tracer("compare " + d + "a.exr " + d + "a.exr");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("8x8, linear radiance: RMSE 0,"), std::string::npos) << r.output;
+  // An image with one NaN texel, a 2048 x 1024 one cut after 400 bytes, a PNG header claiming
+  // 8192 x 8192 with no pixels behind it, and an EXR header claiming 4000000 x 1 (sizes are read
+  // from the headers, before any pixel is decoded).
+  {
+    Framebuffer fa = read_exr(d + "a.exr");
+    write_nan_exr(d + "nan.exr", fa);
+    Framebuffer big(2048, 1024);
+    std::ofstream(d + "cut.exr", std::ios::binary) << encode_exr(big, ExrPixel::Float).substr(0, 400);
+    std::string png = encode_png(read_image(d + "a.png"));
+    png.replace(16, 8, std::string("\0\0\x20\0\0\0\x20\0", 8));
+    std::ofstream(d + "claim.png", std::ios::binary) << png.substr(0, 33);
+    write_wide_exr_header(d + "huge.exr");
+  }
   r = test::run_tracer("compare " + d + "a.exr " + d + "b.exr");  // another seed: noise, not zero
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("RMSE 0,"), std::string::npos) << r.output;
@@ -286,7 +338,11 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   for (const auto& [args, code, message] :
        {std::tuple{"a.exr c.exr", 2, "compare: sizes differ (8x8 and 8x6)"},
         std::tuple{"a.exr a.png", 2, "compare: both images must be EXR (linear) or both PNG/PPM (display)"},
-        std::tuple{"a.exr none.exr", 1, "none.exr: cannot read EXR"}}) {
+        std::tuple{"a.exr none.exr", 1, "none.exr: cannot open: no such file"},
+        std::tuple{"a.exr nan.exr", 1, "nan.exr: 3 pixel values are not finite (NaN or infinity)"},
+        std::tuple{"cut.exr cut.exr", 1, "cut.exr: "},
+        std::tuple{"a.png claim.png", 2, "compare: sizes differ (8x8 and 8192x8192)"},
+        std::tuple{"a.exr huge.exr", 1, "huge.exr: 4000000 x 1 pixels, outside the 1 to 16384 a side tracer reads"}}) {
     std::string a = args;
     a.insert(a.find(' ') + 1, d);
     r = test::run_tracer("compare " + d + a);

@@ -12,10 +12,12 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
 #include "base/errors.hpp"
+#include "base/read_input.hpp"
 
 namespace tracer {
 namespace {
@@ -114,18 +116,67 @@ std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<
   }
 }
 
-Framebuffer read_exr(const std::string& path, const ExrLayer& layer) {
+namespace {
+
+// OpenEXR reads through a stream; this one reads bytes already in memory (read once, by
+// read_input, with its limits), so the header can be checked before any pixel is decoded.
+class MemoryIStream : public Imf::IStream {
+ public:
+  explicit MemoryIStream(std::string_view bytes) : Imf::IStream("memory"), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (pos_ + size_t(n) > bytes_.size()) throw std::runtime_error("the file ends early");
+    std::memcpy(c, bytes_.data() + pos_, size_t(n));
+    pos_ += size_t(n);
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = size_t(pos); }
+
+ private:
+  std::string_view bytes_;
+  size_t pos_ = 0;
+};
+
+// The data window's size, refused past kMaxImagePixels.
+ImageSize window_size(const Imf::Header& header, const std::string& path) {
+  const Imath::Box2i window = header.dataWindow();
+  const long long w = (long long)window.max.x - window.min.x + 1, h = (long long)window.max.y - window.min.y + 1;
+  check_image_size(path, w, h);
+  return {int(w), int(h)};
+}
+
+}  // namespace
+
+ImageSize exr_size(std::string_view bytes, const std::string& path) {
   try {
-    Imf::InputFile file(path.c_str());
+    MemoryIStream stream(bytes);
+    Imf::InputFile file(stream);
+    return window_size(file.header(), path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read EXR: " + e.what());
+  }
+}
+
+Framebuffer decode_exr(std::string_view bytes, const std::string& path, const ExrLayer& layer) {
+  try {
+    MemoryIStream stream(bytes);
+    Imf::InputFile file(stream);
+    const auto [w, h] = window_size(file.header(), path);
     const Imath::Box2i window = file.header().dataWindow();
-    const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
+    for (int c = 0; c < 3; ++c) {
+      const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
+      if (!file.header().channels().findChannel(name)) throw InputError(path + ": no channel " + name);
+    }
+    // Nothing is allocated for pixels the file does not hold (a header alone claims any size).
+    if (!file.isComplete()) throw InputError(path + ": truncated: the file ends before its pixels do");
     std::vector<float> planes(3 * size_t(w) * size_t(h));
     Imf::FrameBuffer frame;
     for (int c = 0; c < 3; ++c) {
       const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
-      if (!file.header().channels().findChannel(name)) throw InputError(path + ": no channel " + name);
       char* base = reinterpret_cast<char*>(planes.data() + size_t(c) * size_t(w) * size_t(h));
-      base -= (size_t(window.min.x) + size_t(window.min.y) * size_t(w)) * sizeof(float);
+      base -= (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));
       frame.insert(name, Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
     }
     file.setFrameBuffer(frame);
@@ -144,6 +195,10 @@ Framebuffer read_exr(const std::string& path, const ExrLayer& layer) {
   } catch (const std::exception& e) {
     throw InputError(path + ": cannot read EXR: " + e.what());
   }
+}
+
+Framebuffer read_exr(const std::string& path, const ExrLayer& layer) {
+  return decode_exr(read_input(path), path, layer);
 }
 
 }  // namespace tracer

@@ -3,10 +3,12 @@
 
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "base/enum_names.hpp"
 #include "film/framebuffer.hpp"
+#include "io/image_size.hpp"
 
 namespace tracer {
 
@@ -27,8 +29,13 @@ struct ExrLayer {
 std::string encode_exr(const Framebuffer& fb, ExrPixel pixel, const std::vector<ExrLayer>& layers = {},
                        size_t* clamped = nullptr);
 
-// Reads an EXR's R, G, B channels as floats (tests, image comparison), or those of a layer
-// (NAME.R ... as encode_exr writes them); throws InputError.
+// An EXR's size from its header alone (refused past kMaxImagePixels); throws InputError.
+ImageSize exr_size(std::string_view bytes, const std::string& path);
+
+// An EXR's R, G, B channels as floats (tests, image comparison), or those of a layer (NAME.R ...
+// as encode_exr writes them). Throws InputError: unreadable, too large (kMaxImagePixels), or
+// truncated, refused before the pixels are allocated.
+Framebuffer decode_exr(std::string_view bytes, const std::string& path, const ExrLayer& layer = {});
 Framebuffer read_exr(const std::string& path, const ExrLayer& layer = {});
 
 }  // namespace tracer

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "base/errors.hpp"
+#include "base/read_input.hpp"
 #include "io/image_io.hpp"
 
 namespace tracer {
@@ -15,6 +17,17 @@ ImageDifference compare_images(const std::string& a, const std::string& b) {
   if (exr_a != exr_b) throw UsageError("compare: both images must be EXR (linear) or both PNG/PPM (display)");
   ImageDifference d;
   d.linear = exr_a;
+  // Both read (within read_input's limits) and their sizes compared from the headers, before
+  // either is decoded.
+  const std::string bytes_a = read_input(a), bytes_b = read_input(b);
+  const ImageSize sa = d.linear ? exr_size(bytes_a, a) : image8_size(bytes_a, a);
+  const ImageSize sb = d.linear ? exr_size(bytes_b, b) : image8_size(bytes_b, b);
+  if (!(sa == sb)) {
+    throw UsageError("compare: sizes differ (" + std::to_string(sa.width) + "x" + std::to_string(sa.height) + " and " +
+                     std::to_string(sb.width) + "x" + std::to_string(sb.height) + ")");
+  }
+  d.width = sa.width;
+  d.height = sa.height;
   double sum = 0.0;
   size_t n = 0;
   const auto add = [&](double x, double y) {
@@ -23,17 +36,22 @@ ImageDifference compare_images(const std::string& a, const std::string& b) {
     d.max_abs = std::max(d.max_abs, std::fabs(e));
     ++n;
   };
-  const auto check_size = [&](int wa, int ha, int wb, int hb) {
-    if (wa != wb || ha != hb) {
-      throw UsageError("compare: sizes differ (" + std::to_string(wa) + "x" + std::to_string(ha) + " and " +
-                       std::to_string(wb) + "x" + std::to_string(hb) + ")");
-    }
-    d.width = wa;
-    d.height = ha;
-  };
   if (d.linear) {
-    const Framebuffer fa = read_exr(a), fb = read_exr(b);
-    check_size(fa.width(), fa.height(), fb.width(), fb.height());
+    const Framebuffer fa = decode_exr(bytes_a, a), fb = decode_exr(bytes_b, b);
+    // A NaN or infinity has no difference to measure: refused, naming the file and the count.
+    for (const auto& [image, path] : {std::pair{&fa, &a}, {&fb, &b}}) {
+      size_t bad = 0;
+      for (int y = 0; y < image->height(); ++y) {
+        for (int x = 0; x < image->width(); ++x) {
+          const Vec3 p = image->radiance(x, y);
+          for (int c = 0; c < 3; ++c) bad += std::isfinite(p[c]) ? 0 : 1;
+        }
+      }
+      if (bad > 0) {
+        throw InputError(*path + ": " + std::to_string(bad) +
+                         " pixel values are not finite (NaN or infinity): no difference can be measured");
+      }
+    }
     for (int y = 0; y < fa.height(); ++y) {
       for (int x = 0; x < fa.width(); ++x) {
         const Vec3 p = fa.radiance(x, y), q = fb.radiance(x, y);
@@ -41,8 +59,7 @@ ImageDifference compare_images(const std::string& a, const std::string& b) {
       }
     }
   } else {
-    const Image8 ia = read_image(a), ib = read_image(b);
-    check_size(ia.width, ia.height, ib.width, ib.height);
+    const Image8 ia = decode_image(bytes_a, a), ib = decode_image(bytes_b, b);
     for (size_t i = 0; i < ia.rgb.size(); ++i) add(ia.rgb[i] / 255.0, ib.rgb[i] / 255.0);
   }
   d.rmse = n > 0 ? std::sqrt(sum / double(n)) : 0.0;

@@ -212,9 +212,23 @@ size_t write_render(const std::string& path, const Framebuffer& fb, float exposu
   return clamped;
 }
 
-Image8 read_image(const std::string& path) {
+ImageSize image8_size(std::string_view bytes, const std::string& path) {
   int w = 0, h = 0, channels = 0;
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 3);  // stb reads PNG and binary PPM
+  const int size = int(std::min<size_t>(bytes.size(), size_t(INT32_MAX)));
+  if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), size, &w, &h, &channels)) {
+    throw InputError(path + ": cannot read image: " + stbi_failure_reason());
+  }
+  check_image_size(path, w, h);
+  return {w, h};
+}
+
+Image8 decode_image(std::string_view bytes, const std::string& path) {
+  image8_size(bytes, path);
+  int w = 0, h = 0, channels = 0;
+  const int size = int(std::min<size_t>(bytes.size(), size_t(INT32_MAX)));
+  // stb reads PNG and binary PPM; 16-bit PNGs come as 8 bits.
+  unsigned char* data =
+      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), size, &w, &h, &channels, 3);
   if (!data) throw InputError(path + ": cannot read image: " + stbi_failure_reason());
   Image8 img;
   img.width = w;
@@ -223,5 +237,7 @@ Image8 read_image(const std::string& path) {
   stbi_image_free(data);
   return img;
 }
+
+Image8 read_image(const std::string& path) { return decode_image(read_input(path), path); }
 
 }  // namespace tracer

@@ -53,5 +53,9 @@ std::string resolve_output(const std::string& path);
 
 // Reads a PNG or PPM written by write_image (tests, image comparison); throws InputError.
 Image8 read_image(const std::string& path);
+// The same from bytes in memory, and the size alone from the header (refused past
+// kMaxImagePixels); both throw InputError naming `path`.
+Image8 decode_image(std::string_view bytes, const std::string& path);
+ImageSize image8_size(std::string_view bytes, const std::string& path);
 
 }  // namespace tracer
