@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   g++ clang cmake ninja-build pkg-config git ca-certificates
   libtinyobjloader-dev libfast-float-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libembree-dev zlib1g-dev
   libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
   libopenmpi-dev openmpi-bin libcpp-httplib-dev
   chromium  # tracer view's browser test (headless)

@@ -12,6 +12,9 @@
 #include <string>
 #include <thread>
 
+#include <zlib.h>
+#include <nlohmann/json.hpp>
+
 #include "base/errors.hpp"
 #include "parallel/executor.hpp"
 #include "scene/obj_loader.hpp"
@@ -210,7 +213,7 @@ TEST_F(Hardening, TextureBombsAreRefusedFromTheirHeader) {
   EXPECT_NE(warnings[0].find("more than the 67108864 a texture may have"), std::string::npos) << warnings[0];
   // And the total: two real textures with a cap below their sum.
   LoadLimits limits;
-  limits.textures.max_total_bytes = 4;  // one 1x1 texture is 3 bytes
+  limits.textures.max_total_bytes = 20;  // a 1x1 texture keeps 4 bytes and takes at most 18 to decode
   std::ofstream(in("two.mtl")) << "newmtl a\nmap_Kd s-0001.png\nnewmtl b\nmap_Kd t.ppm\n";
   std::ofstream(in("t.ppm"), std::ios::binary) << "P6\n1 1\n255\n" << std::string(3, '\x7f');
   std::ofstream(in("two.obj")) << "mtllib two.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n"
@@ -221,6 +224,73 @@ TEST_F(Hardening, TextureBombsAreRefusedFromTheirHeader) {
   EXPECT_EQ(two.textures.size(), 1u);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("the scene's textures would take more than"), std::string::npos) << warnings[0];
+}
+
+// A 16-bit RGB PNG of w x h black texels (zlib-compressed rows: a 4096^2 one is ~100 KB).
+std::string png16(int w, int h) {
+  const auto chunk = [](const std::string& type, const std::string& data) {
+    std::string c;
+    for (int s = 24; s >= 0; s -= 8) c += char((data.size() >> s) & 255);
+    c += type + data;
+    const uLong crc = crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(c.data() + 4), uInt(c.size() - 4));
+    for (int s = 24; s >= 0; s -= 8) c += char((crc >> s) & 255);
+    return c;
+  };
+  std::string ihdr;
+  for (int v : {w, h})
+    for (int s = 24; s >= 0; s -= 8) ihdr += char((v >> s) & 255);
+  ihdr += std::string("\x10\x02\x00\x00\x00", 5);  // 16 bits, RGB
+  z_stream z{};
+  deflateInit(&z, 9);
+  const std::string row(size_t(w) * 6 + 1, '\0');
+  std::string idat;
+  std::vector<unsigned char> out(1 << 16);
+  for (int y = 0; y < h; ++y) {
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(row.data()));
+    z.avail_in = uInt(row.size());
+    do {
+      z.next_out = out.data();
+      z.avail_out = uInt(out.size());
+      deflate(&z, y + 1 == h ? Z_FINISH : Z_NO_FLUSH);
+      idat.append(reinterpret_cast<char*>(out.data()), out.size() - z.avail_out);
+    } while (z.avail_out == 0);
+  }
+  deflateEnd(&z);
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", idat) + chunk("IEND", "");
+}
+
+// Twelve 16-bit 4096^2 textures (stb_image decodes each through ~400 MB of buffers) under a
+// 512 MiB budget: the process's peak stays within the budget and a stated 160 MiB for the rest.
+TEST_F(Hardening, TheTextureBudgetBoundsPeakMemory) {
+  const std::string png = png16(4096, 4096);
+  std::ofstream obj(in("many.obj")), mtl(in("many.mtl"));
+  obj << "mtllib many.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n";
+  for (int i = 0; i < 12; ++i) {
+    std::ofstream(in("t" + std::to_string(i) + ".png"), std::ios::binary) << png;
+    mtl << "newmtl m" << i << "\nmap_Kd t" << i << ".png\n";
+    obj << "usemtl m" << i << "\nf 1/1 2/2 3/3\n";
+  }
+  obj.close();
+  mtl.close();
+  const test::CommandResult r = test::run_tracer("render " + in("many.obj") +
+                                                 " --max-texture-mib 512 --threads 2 --integrator ao --width 8 "
+                                                 "--height 8 -o " +
+                                                 in("m.png") + " --stats-json " + in("s.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("10 map_Kd texture(s) not used"), std::string::npos) << r.output;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(in("s.json")));
+  EXPECT_LT(stats["peak_rss_mib"].get<double>(), 512.0 + 160.0) << stats.dump();
+}
+
+TEST_F(Hardening, ATextureOfOnlyItsHeaderSaysWhy) {
+  std::ofstream(in("ihdr.png"), std::ios::binary) << png_header(8, 8);
+  try {
+    load_texture(in("ihdr.png"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ihdr.png: cannot read texture: corrupt or truncated"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(Hardening, TexturesThatAreNoRegularFileSayWhy) {

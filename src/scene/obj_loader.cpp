@@ -1,5 +1,6 @@
 #include "scene/obj_loader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "base/byte_budget.hpp"
 #include "base/read_input.hpp"
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
@@ -241,8 +243,8 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
       t.file_of[i] = it->second;
     }
   }
-  // 2. Every file read and its header checked, in parallel; 3. the total budget decided in file
-  // order (so which texture is left out never depends on threads); 4. the rest decoded in parallel.
+  // 2. Every file read and its header checked, in parallel; 3. the budget decided in file order (so
+  // which texture is left out never depends on threads); 4. the rest decoded in parallel.
   std::vector<EncodedTexture> encoded(files.size());
   t.file_problem.resize(files.size());
   t.decoded.resize(files.size());
@@ -256,19 +258,31 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
   limits.for_each(files.size(),
                   [&](size_t k) { guarded(k, [&] { encoded[k] = read_texture(files[k], limits.textures, cancel); }); });
   throw_if_cancelled(cancel);
-  uint64_t texture_bytes = 0;
+  // The budget holds the decoded textures and, beside them, the largest decode's transient
+  // buffers: decodes then run at once only while their transients fit what is left (ByteBudget),
+  // and one always can, so peak memory stays within the budget (and the encoded files' bytes).
+  const uint64_t budget = limits.textures.max_total_bytes;
+  uint64_t kept = 0, largest_transient = 0;
   for (size_t k = 0; k < files.size(); ++k) {
     if (!t.file_problem[k].empty()) continue;
-    if (texture_bytes + encoded[k].decoded_bytes() > limits.textures.max_total_bytes) {
-      t.file_problem[k] = "the scene's textures would take more than " +
-                          std::to_string(limits.textures.max_total_bytes >> 20) + " MiB (--max-texture-mib raises it)";
+    const uint64_t final_bytes = encoded[k].decoded_bytes();
+    const uint64_t transient = encoded[k].decode_peak_bytes() - final_bytes;
+    if (kept + final_bytes + std::max(largest_transient, transient) > budget) {
+      t.file_problem[k] = "the scene's textures would take more than " + std::to_string(budget >> 20) +
+                          " MiB to decode (--max-texture-mib raises it)";
       encoded[k] = {};
       continue;
     }
-    texture_bytes += encoded[k].decoded_bytes();
+    kept += final_bytes;
+    largest_transient = std::max(largest_transient, transient);
   }
+  ByteBudget transients(budget - kept);
   limits.for_each(files.size(), [&](size_t k) {
-    if (t.file_problem[k].empty()) guarded(k, [&] { t.decoded[k] = decode_texture(encoded[k]); });
+    if (t.file_problem[k].empty()) {
+      const uint64_t transient = encoded[k].decode_peak_bytes() - encoded[k].decoded_bytes();
+      const ByteBudget::Taken held(transients, transient);
+      guarded(k, [&] { t.decoded[k] = decode_texture(encoded[k]); });
+    }
     encoded[k] = {};  // the encoded bytes are no longer needed
   });
   throw_if_cancelled(cancel);

@@ -149,6 +149,17 @@ Vec3 Texture::bilinear(float u, float v) const {
   return blend(footprint(u, v, width_, height_), [&](int x, int y) { return texel(x, y); });
 }
 
+namespace {
+
+// stb_image's reason for a failure; it gives none for some files that end early (a PNG of only
+// its IHDR chunk).
+std::string stb_reason() {
+  const char* why = stbi_failure_reason();
+  return why && *why ? why : "corrupt or truncated (no image data)";
+}
+
+}  // namespace
+
 EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
   EncodedTexture t;
   t.name = path.string();
@@ -162,8 +173,11 @@ EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, C
   int channels = 0;
   if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size()), &t.width, &t.height,
                              &channels)) {
-    throw InputError(t.name + ": cannot read texture: " + stbi_failure_reason());
+    throw InputError(t.name + ": cannot read texture: " + stb_reason());
   }
+  t.bytes_per_value =
+      stbi_is_16_bit_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size())) ? 2 : 1;
+  t.channels = std::clamp(channels, 1, 4);
   if (uint64_t(t.width) * uint64_t(t.height) > limits.max_texels) {
     throw InputError(t.name + ": " + std::to_string(t.width) + "x" + std::to_string(t.height) +
                      " texels, more than the " + std::to_string(limits.max_texels) + " a texture may have");
@@ -175,7 +189,7 @@ Texture decode_texture(const EncodedTexture& t) {
   int w = 0, h = 0, channels = 0;
   unsigned char* texels = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size()),
                                                 &w, &h, &channels, 3);
-  if (!texels) throw InputError(t.name + ": cannot read texture: " + stbi_failure_reason());
+  if (!texels) throw InputError(t.name + ": cannot read texture: " + stb_reason());
   std::vector<uint8_t> srgb(texels, texels + size_t(w) * size_t(h) * 3);
   stbi_image_free(texels);
   return Texture(w, h, std::move(srgb));

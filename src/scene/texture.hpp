@@ -59,8 +59,16 @@ struct EncodedTexture {
   std::string name;
   std::string bytes;
   int width = 0, height = 0;
+  int channels = 3;         // in the file (with alpha, or a palette's 1)
+  int bytes_per_value = 1;  // 2 for a 16-bit PNG
   // Its texels and mip levels (a third more) once decoded.
   uint64_t decoded_bytes() const { return uint64_t(width) * uint64_t(height) * 4; }
+  // The most memory its decode holds at once, per texel: stb_image's inflated data and image in
+  // the file's layout, its conversion to RGB and to 8 bits, tracer's copy and the mip levels.
+  uint64_t decode_peak_bytes() const {
+    const uint64_t b = uint64_t(bytes_per_value);
+    return uint64_t(width) * uint64_t(height) * (uint64_t(channels) * b + 4 * b + 3 * b + 3 + 4);
+  }
 };
 
 // Reads any image stb_image reads (PNG, JPEG, ...) and its header: throws InputError naming the
