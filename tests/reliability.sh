@@ -55,6 +55,7 @@ printf 'v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n' > nan.obj
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n' > range.obj
 printf '# nothing\n' > empty.obj
 printf 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n' > same.obj
+printf 'v 0 0 0\nv 1e-30 0 0\nv 0 1e-30 0\nf 1 2 3\n' > tiny.obj
 printf 'v 0 0 0\nv 1\001 0 0\nv 0 1 0\nf 1 2 3\n' > control.obj
 printf '\357\273\277v 0 0 0\nv +1 0 1e-50\nv 0 1 0\nf 1 2 3\n' > bom.obj
 { printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n'; for i in $(seq 20000); do printf 'usemtl undefined%d\nf 1 2 3\n' "$i"; done; } > materials.obj
@@ -122,6 +123,12 @@ cases=(
   "scene from standard input (-)|tracer render - -q --width 32 --height 32 -o stdin.png < ok.obj|0"
   "scene from a pipe|tracer render <(cat ok.obj) -q --width 32 --height 32 -o pipe.png|0"
   "scene from a FIFO|(cat ok.obj > fifo.obj &) ; tracer render fifo.obj -q --width 32 --height 32 -o fifo.png|0"
+  "a scene of extent 1e-30, no camera flags|tracer render tiny.obj -q|1"
+  "--max-input-mib 99999999999999999999|tracer render --max-input-mib 99999999999999999999 -q|2"
+  "--stats-json ''|tracer render -q --stats-json ''|2"
+  "--stats-json - (standard output)|tracer render -q --width 8 --height 8 -o s.png --stats-json - > /dev/null|0"
+  "bench --json and --plot one file|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes ok.obj --json b.json --plot ./b.json|2"
+  "bench --json is a scene's MTL|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes tex.obj --json tex.mtl|2"
   "camera beyond +-1e18|tracer render --eye 0,1,1e19 --look 0,1,0 -q|2"
   "--stats-json is the scene|tracer render ok.obj -q --stats-json ok.obj|2"
   "--stats-json is the -o image|tracer render ok.obj -q -o a.png --stats-json ./a.png|2"

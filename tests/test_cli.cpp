@@ -32,6 +32,11 @@ struct CliCase {
   const char* message;
 };
 
+std::string slurp_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 int count_lines(const std::string& s) {
   int n = 0;
   for (char c : s) n += c == '\n';
@@ -47,6 +52,7 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ + "/empty.obj") << "# nothing\n";
     std::ofstream(dir_ + "/ok.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
     std::ofstream(dir_ + "/same.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
+    std::ofstream(dir_ + "/tiny.obj") << "v 0 0 0\nv 1e-30 0 0\nv 0 1e-30 0\nf 1 2 3\n";
     std::ofstream(dir_ + "/bad.exr") << "v/1\x01 not an EXR";
     std::ofstream(dir_ + "/bad.hdr") << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4000000 +X 4000000\n";
     // Not called views.tsv: that name beside ok.obj would give plain renders of ok.obj its view.
@@ -98,6 +104,12 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --light 1e30,0,0", 2, "--light: coordinates must lie within +-1e12"},
       {"render --light 1e12,0,4e38", 2, "--light: '4e38' is out of range (not a finite float)"},
       {"render SAME", 1, "same.obj: all vertices coincide"},
+      {"render TINY", 1, "tiny.obj: the scene is too small to frame (its extent, 1e-30"},
+      {"render --max-input-mib 99999999999999999999", 2,
+       "--max-input-mib: must be between 1 and 1048576, got 99999999999999999999"},
+      {"render --max-texture-mib 0", 2, "--max-texture-mib: must be between 1 and 1048576, got 0"},
+      {"render --stats-json ''", 2, "--stats-json: an empty file name"},
+      {"render --env-map ''", 2, "--env-map: an empty file name"},
       {"render --integrator foo", 2, "--integrator: unknown integrator 'foo'"},
       {"render --integrator path --spp 0", 2, "--spp: must be between 1 and 1048576, got 0"},
       {"render --integrator ao --env 1,1,1", 2, "--env: only for --integrator path or whitted"},
@@ -135,6 +147,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
                                     {"RANGE", "range.obj"},
                                     {"EMPTY", "empty.obj"},
                                     {"SAME", "same.obj"},
+                                    {"TINY", "tiny.obj"},
                                     {"BADEXR", "bad.exr"},
                                     {"BADHDR", "bad.hdr"},
                                     {"BADVIEWS", "badviews.tsv"},
@@ -156,6 +169,33 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
     const fs::path ext = entry.path().extension();
     EXPECT_TRUE(ext == ".obj" || ext == ".tsv" || ext == ".exr" || ext == ".hdr") << entry.path();
   }
+}
+
+// --stats-json - writes the statistics to standard output.
+TEST_F(Cli, StatsJsonDashIsStandardOutput) {
+  const std::string cmd =
+      std::string(TRACER_EXE) + " render -q --width 8 --height 8 -o " + dir_ + "/o.png --stats-json - 2>/dev/null";
+  const test::CommandResult r = test::run_shell(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["width"], 8);
+  EXPECT_FALSE(fs::exists(dir_ + "/-"));
+  EXPECT_FALSE(fs::exists("-"));
+}
+
+// Two outputs of one bench that are one file, and an output that is an MTL file of a scene: both
+// refused before any cell runs (no table printed).
+TEST_F(Cli, BenchOutputsAreRefusedBeforeTheBenchmarkRuns) {
+  std::ofstream(dir_ + "/m.obj") << "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
+  std::ofstream(dir_ + "/m.mtl") << "newmtl a\nKd 0.5\n";
+  const std::string bench = "bench --size 8x8 --runs 1 --best 1 --variants bvh --scenes " + dir_ + "/m.obj ";
+  auto r = test::run_tracer(bench + "--json " + dir_ + "/x.json --plot " + dir_ + "/./x.json");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--json: '" + dir_ + "/x.json' is also the --plot file"), std::string::npos) << r.output;
+  r = test::run_tracer(bench + "--json " + dir_ + "/m.mtl");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--json: '" + dir_ + "/m.mtl' is an input of this run"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("| m"), std::string::npos) << r.output;  // no cell ran
+  EXPECT_EQ(slurp_text(dir_ + "/m.mtl"), "newmtl a\nKd 0.5\n");
 }
 
 TEST_F(Cli, OutputErrors) {

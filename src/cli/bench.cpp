@@ -46,9 +46,9 @@ void add_bench_options(CLI::App& app, BenchArgs& a) {
   app.add_option("--max-seconds", a.max_seconds,
                  "time cap per cell, all its runs together: later runs are skipped, a run at the cap is stopped")
       ->capture_default_str();
-  app.add_option("--json", a.json, "write raw figures as JSON");
-  app.add_option("--plot", a.plot, "write a grouped bar chart (SVG, log scale)");
-  app.add_option("--markdown", a.markdown, "also write the tables to this Markdown file");
+  file_option(app.add_option("--json", a.json, "write raw figures as JSON"));
+  file_option(app.add_option("--plot", a.plot, "write a grouped bar chart (SVG, log scale)"));
+  file_option(app.add_option("--markdown", a.markdown, "also write the tables to this Markdown file"));
   app.add_flag("--list", a.list, "list the variants and exit");
 }
 
@@ -72,10 +72,16 @@ int run_bench(const BenchArgs& a) {
   const std::vector<SceneEntry> scenes = resolve_scenes(a);
   const std::pair<const std::string*, const char*> outputs[] = {
       {&a.json, "--json"}, {&a.plot, "--plot"}, {&a.markdown, "--markdown"}};
-  // Up front against the scene files (loaded later, one at a time) and the views file (read).
+  // Up front against each other, the scene files (loaded later, one at a time) and the views
+  // file (read); after each scene's load against its MTL files and textures, before its cells run.
   for (const auto& [out, flag] : outputs) {
     if (out->empty()) continue;
     check_output(*out, flag);
+    for (const auto& [other, other_flag] : outputs) {
+      if (other != out && !other->empty() && same_file(*out, *other)) {
+        throw UsageError(std::string(flag) + ": '" + *out + "' is also the " + other_flag + " file");
+      }
+    }
     for (const SceneEntry& se : scenes) {
       if (!se.path.empty() && same_file(*out, se.path)) {
         throw UsageError(std::string(flag) + ": '" + *out + "' is an input of this run (" + se.path + ")");
@@ -96,6 +102,9 @@ int run_bench(const BenchArgs& a) {
   for (const SceneEntry& se : scenes) {
     const auto t_load = Clock::now();
     Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
+    for (const auto& [out, flag] : outputs) {
+      if (!out->empty()) check_output(*out, flag);
+    }
     if (se.view) apply_view_light(scene, *se.view);
     const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_load).count();
     const CameraSpec cam = se.view ? se.view->camera : scene.camera ? *scene.camera : frame_bounds(scene.bounds);

@@ -97,7 +97,7 @@ int cmd_render(const RenderArgs& args) {
                                       args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &load_phases);
   stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);
-  if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
+  write_stats_json(args.stats_json, stats);
   return 0;
 }
 
@@ -142,12 +142,12 @@ int main(int argc, char** argv) {
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image");
   add_render_options(*render, render_args);
-  render
-      ->add_option("-o,--output", render_args.output,
-                   "output image: .png or .ppm (tone-mapped), .exr (linear radiance)")
+  file_option(render->add_option("-o,--output", render_args.output,
+                                 "output image: .png or .ppm (tone-mapped), .exr (linear radiance)"))
       ->capture_default_str();
   render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
-  render->add_option("--stats-json", render_args.stats_json, "write the statistics as JSON to this file");
+  file_option(render->add_option("--stats-json", render_args.stats_json,
+                                 "write the statistics as JSON to this file ('-': standard output)"));
   render->add_flag("-q,--quiet", render_args.quiet, "no progress bar, no loader warnings");
   render->add_flag("--save-partial", render_args.save_partial,
                    "on Ctrl-C, write the image with unfinished tiles black");

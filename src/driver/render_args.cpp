@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -23,25 +24,49 @@ namespace tracer::driver {
 
 namespace fs = std::filesystem;
 
+CLI::Option* file_option(CLI::Option* option) {
+  return option->check(CLI::Validator(
+      [](const std::string& s) { return s.empty() ? std::string("an empty file name") : std::string(); }, "FILE"));
+}
+
+namespace {
+
+// A whole number in [lo, hi], checked on the text as given (CLI11 saturates a number beyond
+// long long, so the message would otherwise quote 9223372036854775807).
+CLI::Option* whole_option(CLI::Option* option, long long lo, long long hi) {
+  return option->check(CLI::Validator(
+      [lo, hi](const std::string& s) {
+        long long v = 0;
+        const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+        if (ptr == s.data() + s.size() && ec == std::errc{} && v >= lo && v <= hi) return std::string();
+        return "must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + s;
+      },
+      "INT"));
+}
+
+}  // namespace
+
 void add_scene_options(CLI::App& app, SceneArgs& a) {
-  app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)")
-      ->check(CLI::Validator(
-          [](const std::string& s) { return s.empty() ? std::string("an empty file name") : std::string(); }, "FILE"));
+  file_option(app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)"));
   app.add_option("--view", a.view, "render a named view: its scene, camera and light (e.g. sponza, cornell-water)");
-  app.add_option("--views", a.views, "the views file for --view (default ../shared/scenes/views.tsv)");
+  file_option(app.add_option("--views", a.views, "the views file for --view (default ../shared/scenes/views.tsv)"));
   app.add_option("--builtin-spheres", a.builtin_spheres,
                  "built-in scene: add two spheres of about this many triangles each");
   app.add_option("--light", a.lights, "add a point light at x,y,z (repeatable)");
   app.add_flag("--no-scene-lights", a.no_scene_lights, "drop the scene's emissive lights, keep only --light ones");
   app.add_option("--light-intensity", a.light_intensity, "point light intensity (default: (scene diagonal / 2)^2)");
-  app.add_option("--env-map", a.env_map,
-                 "path, whitted: light the scene from beyond with this equirectangular environment map (.exr or "
-                 ".hdr, linear radiance; times --env)");
+  file_option(
+      app.add_option("--env-map", a.env_map,
+                     "path, whitted: light the scene from beyond with this equirectangular environment map (.exr or "
+                     ".hdr, linear radiance; times --env)"));
   app.add_option("--env-rotation", a.env_rotation, "degrees the --env-map turns about +y")->capture_default_str();
-  app.add_option("--max-input-mib", a.max_input_mib, "largest OBJ file read, in MiB (1-1048576)")
+  whole_option(app.add_option("--max-input-mib", a.max_input_mib, "largest OBJ file read, in MiB (1-1048576)"), 1,
+               1 << 20)
       ->capture_default_str();
-  app.add_option("--max-texture-mib", a.max_texture_mib,
-                 "memory all the scene's textures may take, in MiB (1-1048576); past it a texture is not used")
+  whole_option(
+      app.add_option("--max-texture-mib", a.max_texture_mib,
+                     "memory all the scene's textures may take, in MiB (1-1048576); past it a texture is not used"),
+      1, 1 << 20)
       ->capture_default_str();
 }
 
@@ -177,7 +202,7 @@ void check_outputs(const RenderArgs& a) {
     throw UsageError("-o: '" + a.output + "' is the input scene");
   }
   check_writable(a.output);
-  if (a.stats_json.empty()) return;
+  if (a.stats_json.empty() || a.stats_json == "-") return;
   if (!a.scene.scene.empty() && a.scene.scene != "-" && same_file(a.stats_json, a.scene.scene)) {
     throw UsageError("--stats-json: '" + a.stats_json + "' is the input scene");
   }
@@ -187,7 +212,7 @@ void check_outputs(const RenderArgs& a) {
 
 void check_outputs_against_inputs(const RenderArgs& a) {
   for (int frame = 0; frame < a.frames; ++frame) check_output(frame_output(a.output, frame, a.frames), "-o");
-  if (!a.stats_json.empty()) check_output(a.stats_json, "--stats-json");
+  if (!a.stats_json.empty() && a.stats_json != "-") check_output(a.stats_json, "--stats-json");
 }
 
 namespace {
@@ -232,11 +257,11 @@ void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel, const 
 }  // namespace
 
 Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* phases) {
-  check_range("--max-input-mib", (long long)a.max_input_mib, 1, 1 << 20);
-  check_range("--max-texture-mib", (long long)a.max_texture_mib, 1, 1 << 20);
+  check_range("--max-input-mib", a.max_input_mib, 1, 1 << 20);
+  check_range("--max-texture-mib", a.max_texture_mib, 1, 1 << 20);
   LoadLimits limits;
-  limits.max_obj_bytes = a.max_input_mib << 20;
-  limits.textures.max_total_bytes = a.max_texture_mib << 20;
+  limits.max_obj_bytes = uint64_t(a.max_input_mib) << 20;
+  limits.textures.max_total_bytes = uint64_t(a.max_texture_mib) << 20;
   // Textures are read and decoded on every thread the render may use.
   const Executor executor(Strategy::Tbb);
   limits.for_each = [&executor](size_t count, const std::function<void(size_t)>& body) {
@@ -308,6 +333,13 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
                      " degrees frames this scene from too far away (beyond 4e12); widen it or give --eye");
   }
   const Vec3 forward = spec.look - spec.eye;
+  if (length(forward) == 0.0f && a.eye.empty() && a.look.empty()) {
+    // Framed by tracer, not placed by the user: the scene's extent is below what floats resolve.
+    char size[32];
+    std::snprintf(size, sizeof size, "%g", double(std::max({extent.x, extent.y, extent.z})));
+    throw InputError(scene.source + ": the scene is too small to frame (its extent, " + size +
+                     ", is below what a float camera resolves); give --eye and --look");
+  }
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
   return spec;

@@ -15,8 +15,9 @@
 #include "scene/scene.hpp"
 
 namespace CLI {
+class Option;
 class App;  // CLI11: only the files that add or parse flags include it (a heavy header)
-}
+}  // namespace CLI
 
 namespace tracer::driver {
 
@@ -30,8 +31,8 @@ struct SceneArgs {
   std::optional<double> light_intensity;
   std::string env_map;        // an equirectangular .exr or .hdr lighting the scene from beyond
   double env_rotation = 0.0;  // degrees about +y
-  uint64_t max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the OBJ
-  uint64_t max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
+  long long max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the OBJ
+  long long max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
 };
 
 // The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,
@@ -69,6 +70,8 @@ struct RenderArgs {
 };
 
 void add_scene_options(CLI::App& app, SceneArgs& args);
+// A file-name option that refuses an empty name (`--stats-json ''` silently wrote nothing).
+CLI::Option* file_option(CLI::Option* option);
 void add_render_options(CLI::App& app, RenderArgs& args);
 
 // Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.

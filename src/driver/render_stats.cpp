@@ -3,6 +3,9 @@
 #include <sys/resource.h>
 
 #include <cstdio>
+#include <iostream>
+
+#include "io/image_io.hpp"
 
 namespace tracer::driver {
 
@@ -99,6 +102,15 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("throughput   %10.2f Mrays/s", j["mrays_per_s"].get<double>());
   if (integrator == "path") std::printf(", %.3f Msamples/s", j["samples_per_s"].get<double>() * 1e-6);
   std::printf("\n");
+}
+
+void write_stats_json(const std::string& path, const nlohmann::json& j) {
+  if (path.empty()) return;
+  if (path == "-") {
+    std::cout << j.dump(2) << "\n" << std::flush;
+  } else {
+    write_file_atomic(path, j.dump(2) + "\n");
+  }
 }
 
 }  // namespace tracer::driver

@@ -16,4 +16,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 // Prints `j` (from render_stats()) as the --stats text.
 void print_stats(const nlohmann::json& j, const Accelerator& accel);
 
+// --stats-json: `j` written to `path` (atomically), to standard output for "-", nowhere for "".
+void write_stats_json(const std::string& path, const nlohmann::json& j);
+
 }  // namespace tracer::driver

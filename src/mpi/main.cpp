@@ -403,7 +403,7 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
                     (unsigned long long)r["rays"].get<uint64_t>(), r["idle_ms"].get<double>());
       }
     }
-    if (!args.stats_json.empty()) write_file_atomic(args.stats_json, stats.dump(2) + "\n");
+    driver::write_stats_json(args.stats_json, stats);
   }
   return 0;
 }
@@ -425,9 +425,11 @@ int main(int argc, char** argv) {
   driver::RenderArgs args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image, on every rank");
   driver::add_render_options(*render, args);
-  render->add_option("-o,--output", args.output, "output image (written by rank 0)")->capture_default_str();
+  driver::file_option(render->add_option("-o,--output", args.output, "output image (written by rank 0)"))
+      ->capture_default_str();
   render->add_flag("--stats", args.stats, "print timings, ray counts and each rank's tiles, rays and idle time");
-  render->add_option("--stats-json", args.stats_json, "write the statistics as JSON to this file (rank 0)");
+  driver::file_option(render->add_option("--stats-json", args.stats_json,
+                                         "write the statistics as JSON to this file (rank 0; '-': standard output)"));
   render->add_flag("-q,--quiet", args.quiet, "no progress bar, no loader warnings");
   double rank_timeout = mpi::StallWatch{}.floor_seconds;
   render
