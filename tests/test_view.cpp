@@ -6,6 +6,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -27,6 +34,7 @@ using nlohmann::json;
 class ViewServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    std::signal(SIGPIPE, SIG_IGN);  // a request refused from its head may close before its body is sent
     scene_ = make_cornell_box();
     args_.settings.width = 64;
     args_.settings.height = 48;
@@ -267,12 +275,107 @@ TEST(ViewCommand, CopiedCommandKeepsTheUsersFlagsAndStatesTheView) {
   EXPECT_EQ(view::shell_quote(""), "''");
 }
 
+// A raw connection to the viewer: what a browser, a script or an attacker sends, byte for byte.
+class RawConnection {
+ public:
+  explicit RawConnection(int port) : fd_(::socket(AF_INET, SOCK_STREAM, 0)) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(uint16_t(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    timeval tv{5, 0};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  }
+  ~RawConnection() { ::close(fd_); }
+  bool send(const std::string& s) { return ok_ && ::send(fd_, s.data(), s.size(), MSG_NOSIGNAL) == ssize_t(s.size()); }
+  // Everything until the server closes (or 5 s pass).
+  std::string response() {
+    std::string out;
+    char buf[4096];
+    for (ssize_t n; (n = ::recv(fd_, buf, sizeof buf, 0)) > 0;) out.append(buf, size_t(n));
+    return out;
+  }
+
+ private:
+  int fd_;
+  bool ok_ = false;
+};
+
+TEST_F(ViewServerTest, RequestHeadsAreCheckedBeforeTheirBodies) {
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(port_) + "\r\n";
+  const std::string token = server_->token();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"GET /state?token=" + token + "&token=bad HTTP/1.1\r\n" + host + "\r\n", "403 Forbidden"},
+      {"GET /state?token=" + token + " HTTP/1.1\r\nHost: evil.example:" + std::to_string(port_) + "\r\n\r\n",
+       "is not this viewer's address"},
+      {"POST /control?token=" + token + " HTTP/1.1\r\n" + host +
+           "Origin: http://evil.example\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}",
+       "is not this viewer's page"},
+      // A chunked body would bypass the 4 KiB limit (256 MB of it took 1.16 GB of memory).
+      {"POST /control?token=" + token + " HTTP/1.1\r\n" + host +
+           "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n",
+       "Transfer-Encoding is not accepted"},
+      // No Content-Length: answered at once, not after the read timeout.
+      {"POST /control?token=" + token + " HTTP/1.1\r\n" + host + "Content-Type: application/json\r\n\r\n",
+       "411 Length Required"},
+  };
+  for (const auto& [request, expected] : cases) {
+    RawConnection c(port_);
+    ASSERT_TRUE(c.send(request));
+    const std::string response = c.response();
+    EXPECT_NE(response.find(expected), std::string::npos) << request << "\n->\n" << response;
+  }
+  EXPECT_EQ(post(R"({"eye": [1e400, 0, 0]})")->status, 400);
+  // The page itself is served by the address it was opened at.
+  RawConnection ok(port_);
+  ASSERT_TRUE(ok.send("GET /state?token=" + token + " HTTP/1.1\r\n" + host + "Connection: close\r\n\r\n"));
+  EXPECT_EQ(ok.response().rfind("HTTP/1.1 200", 0), 0u);
+}
+
+// Fifty connections trickling header lines, with no token, do not starve the real client: each
+// gets at most kHeadDeadline, and a client address at most a few connections still sending.
+TEST_F(ViewServerTest, SlowConnectionsDoNotStarveTheRealClient) {
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> slow;
+  for (int i = 0; i < 50; ++i) {
+    slow.emplace_back([&, i] {
+      while (!stop) {
+        RawConnection c(port_);
+        if (!c.send("GET /state HTTP/1.1\r\n")) continue;
+        for (int line = 0; line < 40 && !stop && c.send("X-Slow-" + std::to_string(i) + ": 1\r\n"); ++line) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        }
+      }
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  int answered = 0;
+  for (int i = 0; i < 10; ++i) {
+    httplib::Client c = client();
+    c.set_read_timeout(3, 0);
+    c.set_connection_timeout(3, 0);
+    const auto r = c.Get(with_token("/state").c_str());
+    answered += r && r->status == 200 ? 1 : 0;
+  }
+  stop = true;
+  for (std::thread& t : slow) t.join();
+  EXPECT_EQ(answered, 10);
+}
+
+// A second viewer on the same port is refused instead of sharing the connections (SO_REUSEPORT).
+TEST_F(ViewServerTest, ASecondServerOnThePortIsRefused) {
+  view::ViewServer second(*session_, "fedcba9876543210fedcba9876543210");
+  EXPECT_THROW(second.bind("127.0.0.1", port_), UsageError);
+}
+
 TEST(ViewCommand, BadFlagsAreRefused) {
   for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
            {"view --port 70000", "--port"},
            {"view --frames 3", "--frames: not for tracer view"},
            {"view --width 5000", "--width"},
            {"view --listen 256.1.1.1 --port 0", "cannot listen on 256.1.1.1"},
+           {"view --listen '' --port 0", "--listen: an empty address"},
        }) {
     const test::CommandResult r = test::run_tracer(args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;

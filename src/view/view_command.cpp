@@ -25,6 +25,7 @@ int run_view(ViewArgs args) {
   if (!args.width_given) r.settings.width = kDefaultViewSide;
   if (!args.height_given) r.settings.height = kDefaultViewSide;
   check_range("--port", args.port, 0, 65535);
+  if (args.listen.empty()) throw UsageError("--listen: an empty address (127.0.0.1 keeps the viewer to this machine)");
   // The render flags that make files or sequences mean nothing here (save downloads the image).
   if (r.frames != 1) throw UsageError("--frames: not for tracer view (an image sequence is tracer render's)");
   if (r.orbit != 0.0) throw UsageError("--orbit: not for tracer view (drag to orbit)");
@@ -53,6 +54,11 @@ int run_view(ViewArgs args) {
   std::printf("tracer: viewing %s at http://%s:%d/?token=%s (Ctrl-C stops)\n", scene.source.c_str(), host.c_str(), port,
               server.token().c_str());
   std::fflush(stdout);
+  if (!is_loopback_address(args.listen)) {
+    std::cerr << "tracer: warning: --listen " << args.listen
+              << " serves the viewer beyond this machine: anyone who can reach it and sees the URL's token can "
+                 "drive the render (plain HTTP, not encrypted)\n";
+  }
 
   while (!is_cancelled(cancel)) {
     if (listening.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready) {

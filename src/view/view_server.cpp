@@ -4,12 +4,20 @@
 #include <openssl/evp.h>
 #include <nlohmann/json.hpp>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdio>
 #include <random>
 
 #include "base/errors.hpp"
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
+#include "view/connection_guard.hpp"
 
 namespace tracer::view {
 
@@ -34,17 +42,155 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
-bool same_token(const std::string& given, const std::string& token) {
-  if (given.size() != token.size()) return false;
-  unsigned diff = 0;  // every character compared, so the time says nothing of the token
-  for (size_t i = 0; i < token.size(); ++i) diff |= unsigned(given[i] ^ token[i]);
-  return diff == 0;
-}
-
 void error_json(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
   res.set_content(nlohmann::json{{"error", message}}.dump() + "\n", "application/json");
 }
+
+using Clock = std::chrono::steady_clock;
+
+int ms_until(Clock::time_point deadline) {
+  return int(
+      std::max<int64_t>(0, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count()));
+}
+
+// A connection as cpp-httplib's Stream: reads and writes wait at most their timeouts.
+class ConnectionStream : public httplib::Stream {
+ public:
+  explicit ConnectionStream(int sock) : sock_(sock) {}
+  bool is_readable() const override { return wait(POLLIN, kIoTimeoutMs); }
+  bool is_writable() const override { return wait(POLLOUT, kIoTimeoutMs); }
+  ssize_t read(char* ptr, size_t size) override {
+    if (!wait(POLLIN, kIoTimeoutMs)) return -1;
+    return ::recv(sock_, ptr, size, 0);
+  }
+  ssize_t write(const char* ptr, size_t size) override {
+    if (!wait(POLLOUT, kIoTimeoutMs)) return -1;
+    return ::send(sock_, ptr, size, MSG_NOSIGNAL);
+  }
+  void get_remote_ip_and_port(std::string& ip, int& port) const override { address(true, ip, port); }
+  void get_local_ip_and_port(std::string& ip, int& port) const override { address(false, ip, port); }
+  socket_t socket() const override { return sock_; }
+
+  bool wait(short events, int timeout_ms) const {
+    pollfd p{sock_, events, 0};
+    return ::poll(&p, 1, timeout_ms) > 0 && (p.revents & (events | POLLHUP)) != 0;
+  }
+
+ private:
+  static constexpr int kIoTimeoutMs = 5000;
+  void address(bool remote, std::string& ip, int& port) const {
+    sockaddr_storage addr{};
+    socklen_t len = sizeof addr;
+    const int ok = remote ? ::getpeername(sock_, reinterpret_cast<sockaddr*>(&addr), &len)
+                          : ::getsockname(sock_, reinterpret_cast<sockaddr*>(&addr), &len);
+    char text[INET6_ADDRSTRLEN] = "";
+    port = 0;
+    if (ok == 0 && addr.ss_family == AF_INET) {
+      const auto* a = reinterpret_cast<const sockaddr_in*>(&addr);
+      ::inet_ntop(AF_INET, &a->sin_addr, text, sizeof text);
+      port = ntohs(a->sin_port);
+    } else if (ok == 0 && addr.ss_family == AF_INET6) {
+      const auto* a = reinterpret_cast<const sockaddr_in6*>(&addr);
+      ::inet_ntop(AF_INET6, &a->sin6_addr, text, sizeof text);
+      port = ntohs(a->sin6_port);
+    }
+    ip = text;
+  }
+  int sock_;
+};
+
+// The head of the next request, peeked (left in the socket for cpp-httplib to read): empty if
+// the client sent nothing before `first_byte` or closed, or its head did not end within
+// kHeadDeadline of its first byte (or kMaxHeadBytes).
+std::string peek_head(const ConnectionStream& stream, Clock::time_point first_byte, bool& complete) {
+  complete = false;
+  if (!stream.wait(POLLIN, ms_until(first_byte))) return {};
+  const auto deadline = Clock::now() + kHeadDeadline;
+  std::string buffer(kMaxHeadBytes, '\0');
+  for (;;) {
+    const ssize_t n = ::recv(stream.socket(), buffer.data(), buffer.size(), MSG_PEEK);
+    if (n <= 0) return {};
+    const std::string_view seen(buffer.data(), size_t(n));
+    if (const size_t end = seen.find("\r\n\r\n"); end != std::string_view::npos) {
+      complete = true;
+      return std::string(seen.substr(0, end + 4));
+    }
+    if (size_t(n) == buffer.size()) return {};
+    // More is on its way: wait for it (poll sees only new data once the peeked bytes stay).
+    const int left = ms_until(deadline);
+    if (left == 0) return {};
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::min(left, 5)));
+  }
+}
+
+void answer(ConnectionStream& stream, int status, const std::string& message) {
+  const std::string body = nlohmann::json{{"error", message}}.dump() + "\n";
+  const char* reason = status == 400 ? "Bad Request" : status == 403 ? "Forbidden" : "Length Required";
+  const std::string response = "HTTP/1.1 " + std::to_string(status) + " " + reason +
+                               "\r\nContent-Type: application/json\r\nCache-Control: no-store\r\n"
+                               "Connection: close\r\nContent-Length: " +
+                               std::to_string(body.size()) + "\r\n\r\n" + body;
+  stream.write(response.data(), response.size());
+}
+
+}  // namespace
+
+// cpp-httplib's server, each connection first passed through the guard (connection_guard.hpp).
+class GuardedServer : public httplib::Server {
+ public:
+  GuardedServer(const std::string& token) : token_(token) {}
+  void set_address(int port, bool any_host) {
+    port_ = port;
+    any_host_ = any_host;
+  }
+
+ private:
+  bool process_and_close_socket(socket_t sock) override {
+    ConnectionStream stream(sock);
+    std::string client;
+    int client_port = 0;
+    stream.get_remote_ip_and_port(client, client_port);
+    bool ok = true;
+    for (size_t count = keep_alive_max_count_; count > 0 && is_running(); --count) {
+      const auto first_byte =
+          Clock::now() +
+          std::chrono::seconds(count == keep_alive_max_count_ ? read_timeout_sec_ : keep_alive_timeout_sec_);
+      pending_.add(client, sock);
+      bool complete = false;
+      const std::string head = peek_head(stream, first_byte, complete);
+      pending_.remove(client, sock);
+      if (!complete) break;
+      if (const HeadCheck check = check_head(head, token_, port_, any_host_); check.status != 0) {
+        answer(stream, check.status, check.message);
+        // What the client still sends is read briefly and dropped, so it sees the answer rather
+        // than a reset; never more than 64 KiB or 200 ms of it.
+        ::shutdown(sock, SHUT_WR);
+        char sink[4096];
+        const auto until = Clock::now() + std::chrono::milliseconds(200);
+        for (size_t drained = 0; drained < 65536 && stream.wait(POLLIN, ms_until(until));) {
+          const ssize_t n = ::recv(sock, sink, sizeof sink, 0);
+          if (n <= 0) break;
+          drained += size_t(n);
+        }
+        break;
+      }
+      bool connection_closed = false;
+      ok = process_request(stream, count == 1 || !is_running(), connection_closed, nullptr);
+      if (!ok || connection_closed) break;
+    }
+    ::shutdown(sock, SHUT_RDWR);
+    ::close(sock);
+    return ok;
+  }
+
+  const std::string token_;
+  int port_ = 0;
+  bool any_host_ = false;
+  PendingHeads pending_;
+};
+
+namespace {
 
 std::string frame_event(const Frame& f) {
   const nlohmann::json j = {{"seq", f.seq},
@@ -66,6 +212,10 @@ std::string frame_event(const Frame& f) {
 
 }  // namespace
 
+bool is_loopback_address(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
 std::string random_token() {
   std::random_device device;
   std::string token;
@@ -78,7 +228,7 @@ std::string random_token() {
 }
 
 ViewServer::ViewServer(ViewSession& session, std::string token)
-    : session_(session), token_(std::move(token)), server_(std::make_unique<httplib::Server>()) {
+    : session_(session), token_(std::move(token)), server_(std::make_unique<GuardedServer>(token_)) {
   server_->new_task_queue = [] { return new httplib::ThreadPool(kServerThreads); };
   server_->set_payload_max_length(kMaxControlBytes);
   server_->set_keep_alive_timeout(1);  // idle connections do not hold a stop back for long
@@ -88,11 +238,18 @@ ViewServer::ViewServer(ViewSession& session, std::string token)
 ViewServer::~ViewServer() { stop(); }
 
 int ViewServer::bind(const std::string& host, int port) {
+  // SO_REUSEADDR (a restart binds at once) but not cpp-httplib's SO_REUSEPORT, with which a second
+  // viewer on the same port also listened and the kernel split connections between the two.
+  server_->set_socket_options([](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   const int bound = port == 0 ? server_->bind_to_any_port(host) : (server_->bind_to_port(host, port) ? port : -1);
   if (bound <= 0) {
     throw UsageError("--listen/--port: cannot listen on " + host + ":" + std::to_string(port) +
                      " (in use, or not an address of this machine; --port 0 picks a free port)");
   }
+  server_->set_address(bound, !is_loopback_address(host));
   return bound;
 }
 
@@ -105,13 +262,10 @@ void ViewServer::stop() {
 
 void ViewServer::add_routes() {
   httplib::Server& s = *server_;
-  s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+  s.set_pre_routing_handler([](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
-    if (!same_token(req.get_param_value("token"), token_)) {
-      error_json(res, 403, "missing or wrong token: open the URL tracer view printed");
-      return httplib::Server::HandlerResponse::Handled;
-    }
+    // The token, Host and Origin were checked on the request head (GuardedServer).
     return httplib::Server::HandlerResponse::Unhandled;
   });
   s.set_error_handler([](const httplib::Request&, httplib::Response& res) {
@@ -149,7 +303,7 @@ void ViewServer::add_routes() {
     nlohmann::json change;
     try {
       change = nlohmann::json::parse(req.body);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // also a number beyond a double (1e400)
       error_json(res, 400, std::string("not JSON: ") + e.what());
       return;
     }

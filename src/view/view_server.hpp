@@ -1,6 +1,8 @@
 // The viewer's HTTP server (cpp-httplib): the page, the state, changes to it, the frames as
 // server-sent events, and the current image as PNG or EXR downloads. Every request must carry the
-// session's token (?token=...), so a page from another site cannot drive it.
+// session's token (?token=...) once, and name this machine as its Host unless --listen widened
+// it, so a page from another site cannot drive it; connection_guard.hpp checks each request head
+// before cpp-httplib reads the rest.
 //
 //   GET  /             the page (HTML and script, served from the binary)
 //   GET  /state        the view state as JSON
@@ -23,12 +25,16 @@ class Server;
 
 namespace tracer::view {
 
+class GuardedServer;
+
 // Frames and at most this many event streams at once (each holds a server thread).
 inline constexpr int kMaxEventStreams = 16;
 inline constexpr size_t kMaxControlBytes = 4096;
 
 // A token of 128 random bits, as 32 hex digits.
 std::string random_token();
+// Whether --listen keeps the viewer to this machine (127.0.0.0/8, ::1, localhost).
+bool is_loopback_address(const std::string& host);
 
 class ViewServer {
  public:
@@ -49,7 +55,7 @@ class ViewServer {
   void add_routes();
   ViewSession& session_;
   const std::string token_;
-  std::unique_ptr<httplib::Server> server_;
+  std::unique_ptr<GuardedServer> server_;
   std::atomic<int> streams_{0};
 };
 
