@@ -41,6 +41,9 @@ printf '\211PNG\r\n\032\n\000\000\000\rIHDR\000\000\100\000\000\000\100\000\010\
 for i in $(seq 13); do cat rows.bin rows.bin > rows2.bin && mv rows2.bin rows.bin; done
 { printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16256\n'; cat rows.bin; } > big.hdr && rm rows.bin
 "$tracer" render -q --integrator ao --ao 0 --width 2048 --height 1024 -o whole.exr && head -c 400 whole.exr > cut.exr && rm whole.exr
+mkdir envA envB
+"$tracer" render -q --integrator ao --ao 0 --width 8 --height 4 -o envA/sky.exr
+"$tracer" render -q --integrator ao --ao 0 --width 16 --height 8 -o envB/sky.exr
 mkdir viewsdir
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > viewsdir/tri.obj
 printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\ttri.obj\t0,0,3\t0,0\n' > viewsdir/views.tsv
@@ -78,26 +81,34 @@ as_user=()
 MPIRUN="mpirun --allow-run-as-root --oversubscribe"
 # Runs an mpirun command line, stops rank $1 with SIGSTOP once it renders, and once rank 0 has
 # written m.png continues and kills it; exits with mpirun's code.
+# stall_rank RANK [--at-start] COMMAND...: runs COMMAND (an mpirun job) and stops rank RANK with
+# SIGSTOP once it runs (at once with --at-start: in MPI's start-up), then waits for the job to
+# end (rank 0 writes the image and ends the job, or a rank's deadline ends it), continues and
+# kills the stopped rank.
 stall_rank() {
-  local rank=$1 victim="" pid
+  local rank=$1 victim="" pid at_start=0
   shift
+  [[ $1 == --at-start ]] && at_start=1 && shift
   "$@" &
   local job=$!
-  for _ in $(seq 100); do
-    sleep 0.1
+  for _ in $(seq 2000); do
     for pid in $(pgrep -f "tracer-mpi render"); do
       tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$rank" && victim=$pid
     done
     [[ -n $victim ]] && break
+    sleep 0.01
   done
-  sleep 1
+  ((at_start)) || sleep 1
   kill -STOP "$victim"
-  # Rank 0 writes the image and aborts the job; the stopped rank can only die once continued.
   local rank0=""
   for pid in $(pgrep -f "tracer-mpi render"); do
     tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=0" && rank0=$pid
   done
-  for _ in $(seq 300); do [[ -f m.png ]] && ! kill -0 "$rank0" 2>/dev/null && break; sleep 0.1; done
+  for _ in $(seq 600); do
+    kill -0 "$job" 2>/dev/null || break
+    [[ -f m.png ]] && ! kill -0 "$rank0" 2>/dev/null && break
+    sleep 0.1
+  done
   kill -CONT "$victim"
   kill -KILL "$victim" 2>/dev/null
   wait "$job"
@@ -192,6 +203,9 @@ cases=(
   "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
   "tracer-mpi: one rank refuses a flag (an older binary)|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png --newer-flag|2"
   "tracer-mpi: ranks given different --width|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 64 --height 32 -o m.png|2"
+  "tracer-mpi: rank 0 stopped (SIGSTOP) mid-render|stall_rank 0 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 4096 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m0.png|1"
+  "tracer-mpi: rank 1 stopped (SIGSTOP) in start-up|stall_rank 1 --at-start $MPIRUN -np 3 tracer-mpi render -q --integrator ao --width 32 --height 32 --startup-timeout 3 -o m1.png|1"
+  "tracer-mpi: one --env-map path, two files (other working directories)|$MPIRUN -np 1 -wdir envA tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png : -np 1 -wdir envB tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png|1"
   "tracer-mpi: rank 1 stopped (SIGSTOP) mid-render|stall_rank 1 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 1024 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m.png|1"
 )
 

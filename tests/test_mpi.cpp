@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "io/exr_io.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -51,6 +52,15 @@ test::CommandResult run(const std::string& command) {
 }
 
 // The lines tracer-mpi itself printed (mpirun adds a banner of its own to any failed job).
+// Two files' bytes equal; where not, a one-line summary (an EXR's bytes would fill the log).
+::testing::AssertionResult same_bytes(const std::string& got, const std::string& expected) {
+  if (got == expected) return ::testing::AssertionSuccess();
+  size_t at = 0;
+  while (at < got.size() && at < expected.size() && got[at] == expected[at]) ++at;
+  return ::testing::AssertionFailure() << "files differ: " << got.size() << " bytes against " << expected.size()
+                                       << " expected, first at byte " << at;
+}
+
 int own_lines(const std::string& output) {
   int n = 0;
   std::istringstream in(output);
@@ -97,7 +107,7 @@ TEST_F(MpiRender, SameImageAsOneProcessForAnyRanksThreadsAndTiles) {
         const std::string out = dir_ + "/mpi.exr";
         const auto m = run(mpirun(ranks) + kMpiExe + " render " + common + flags + " -o " + out);
         ASSERT_EQ(m.exit_code, 0) << m.output;
-        EXPECT_EQ(read_file(out), expected);
+        EXPECT_TRUE(same_bytes(read_file(out), expected));
       }
     }
   }
@@ -110,7 +120,7 @@ TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
   const auto m = run(mpirun(2) + kMpiExe + " render --threads 1" + common + dir_ + "/two.png");
   ASSERT_EQ(m.exit_code, 0) << m.output;
   for (const char* n : {"-0000.png", "-0001.png", "-0002.png"}) {
-    EXPECT_EQ(read_file(dir_ + "/two" + n), read_file(dir_ + "/one" + n)) << n;
+    EXPECT_TRUE(same_bytes(read_file(dir_ + "/two" + n), read_file(dir_ + "/one" + n))) << n;
     EXPECT_FALSE(read_file(dir_ + "/two" + n).empty()) << n;
   }
 }
@@ -215,6 +225,28 @@ std::pair<int, double> wait_for(pid_t pid) {
   if (waitpid(pid, &status, 0) != pid) return {-1, 0.0};
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), seconds};
+}
+
+// Waits for `pid` at most `limit` seconds (then continues and kills every rank of the job in
+// `dir`, and mpirun): a job that hangs fails its test instead of hanging the suite.
+std::pair<int, double> wait_at_most(pid_t pid, double limit, const std::string& dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (;;) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), seconds};
+    }
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > limit) {
+      for (int r = 0; r < 8; ++r) {
+        for (pid_t p : pids_of_rank(r, dir)) ::kill(p, SIGCONT), ::kill(p, SIGKILL);
+      }
+      ::kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+      return {-1, limit};
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
 }
 
 // A long path render on three ranks, and the pid of the process running rank `rank` once it runs.
@@ -369,7 +401,7 @@ TEST_F(MpiRender, AStalledRankIsWorkedAroundAndNamed) {
                             " stopped answering"),
               std::string::npos)
         << m.output;
-    EXPECT_EQ(read_file(image), expected);
+    EXPECT_TRUE(same_bytes(read_file(image), expected));
     EXPECT_EQ(own_lines(m.output), 1) << m.output;
   }
 }
@@ -383,11 +415,96 @@ TEST_F(MpiRender, AStragglersTilesCountOnce) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string image = dir_ + "/x.exr";
   const auto m = stall_one_rank(mpirun(3) + kMpiExe + common + " --rank-timeout 1 -o " + image, dir_, 1, image, 6.0);
-  EXPECT_EQ(read_file(image), read_file(dir_ + "/ref.exr"));
+  EXPECT_TRUE(same_bytes(read_file(image), read_file(dir_ + "/ref.exr")));
   // Whether 6 s is past the bound depends on how slow the tiles were (8x the slowest): on a loaded
   // machine the pause may go unnoticed. The image is the same whichever way.
   const bool gone = m.output.find("tracer-mpi: error: rank 1 of 3 stopped answering") != std::string::npos;
   EXPECT_EQ(m.exit_code != 0, gone) << m.output;
+}
+
+// Rank 0 stopped mid-render (SIGSTOP): the other ranks wait for its answers at most twice the
+// bound it gives them, then say so, naming rank 0, and the job ends non-zero.
+TEST_F(MpiRender, AStalledRankZeroEndsTheJobNamed) {
+  const std::string image = dir_ + "/x.exr";
+  const std::string log = dir_ + "/log.txt";
+  const pid_t launcher = launch(mpirun(2) + kMpiExe +
+                                    " render --integrator path --spp 4096 --width 96 --height 96 --threads 1 -q "
+                                    "--checkpoint 0.2 --rank-timeout 1 -o " +
+                                    image,
+                                log);
+  // The first checkpoint is written once the render runs on every rank: then rank 0 stops.
+  pid_t victim = -1;
+  for (int i = 0; i < 400 && victim < 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const std::vector<pid_t> pids = pids_of_rank(0, dir_);
+    if (pids.size() == 1 && fs::exists(image)) victim = pids[0];
+  }
+  ASSERT_GT(victim, 0) << read_file(log);
+  ::kill(victim, SIGSTOP);
+  const auto [code, seconds] = wait_at_most(launcher, 120, dir_);
+  ::kill(victim, SIGCONT);
+  ::kill(victim, SIGKILL);
+  const std::string text = read_file(log);
+  EXPECT_NE(code, 0) << text;
+  EXPECT_NE(code, -1) << "the job did not end by itself: " << text;
+  EXPECT_NE(text.find("tracer-mpi: error: rank 1 of 2: rank 0 stopped answering (no answer within"), std::string::npos)
+      << text;
+}
+
+// A rank stopped while the job starts (MPI start-up, loading): every phase has a bound, so the
+// job ends with one message instead of waiting forever.
+TEST_F(MpiRender, ARankStalledInStartUpEndsTheJob) {
+  const std::string log = dir_ + "/log.txt";
+  const pid_t launcher = launch(mpirun(3) + kMpiExe + " render --integrator ao --width 32 --height 32 -q " +
+                                    "--startup-timeout 5 -o " + dir_ + "/x.png",
+                                log);
+  pid_t victim = -1;
+  for (int i = 0; i < 2000 && victim < 0; ++i) {  // as soon as its process exists
+    const std::vector<pid_t> pids = pids_of_rank(1, dir_);
+    if (pids.size() == 1)
+      victim = pids[0];
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_GT(victim, 0) << read_file(log);
+  ::kill(victim, SIGSTOP);
+  const auto [code, seconds] = wait_at_most(launcher, 120, dir_);
+  ::kill(victim, SIGCONT);
+  ::kill(victim, SIGKILL);
+  const std::string text = read_file(log);
+  EXPECT_NE(code, 0) << text;
+  EXPECT_NE(code, -1) << "the job did not end by itself: " << text;
+  EXPECT_NE(text.find("start-up did not end within 5 s"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+}
+
+// Ranks given one --env-map path that names different files (other working directories) render
+// different skies: the map's contents join the scene checksum. A map on one rank only is named.
+TEST_F(MpiRender, EnvironmentMapsJoinTheSceneChecksum) {
+  for (const char* sub : {"/a", "/b"}) {
+    fs::create_directories(dir_ + sub);
+    Framebuffer sky(8, 4);
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 8; ++x) sky.set(x, y, Vec3{sub[1] == 'a' ? 1.0f : 2.0f});
+    std::ofstream(dir_ + sub + "/sky.exr", std::ios::binary) << encode_exr(sky, ExrPixel::Float);
+  }
+  const std::string render =
+      std::string(kMpiExe) + " render --integrator path --spp 1 --width 16 --height 16 -q -o " + dir_ + "/x.png";
+  auto m = run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 -wdir " + dir_ + "/a " + render +
+               " --env-map sky.exr : -np 1 -wdir " + dir_ + "/b " + render + " --env-map sky.exr");
+  EXPECT_EQ(m.exit_code, 1) << m.output;
+  EXPECT_NE(m.output.find("rank 1 of 2 read a different environment map than rank 0 (--env-map 'sky.exr'"),
+            std::string::npos)
+      << m.output;
+  EXPECT_EQ(own_lines(m.output), 1) << m.output;
+  EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+  m = run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 -wdir " + dir_ + "/a " + render +
+          " : -np 1 -wdir " + dir_ + "/b " + render + " --env-map sky.exr");
+  EXPECT_EQ(m.exit_code, 1) << m.output;
+  EXPECT_NE(m.output.find("rank 1 of 2 read a different environment map than rank 0 (--env-map '' on rank 0)"),
+            std::string::npos)
+      << m.output;
+  EXPECT_EQ(own_lines(m.output), 1) << m.output;
 }
 
 }  // namespace

@@ -31,6 +31,7 @@
 #include "driver/signals.hpp"
 #include "io/image_io.hpp"
 #include "mpi/mpi_session.hpp"
+#include "mpi/phase_watch.hpp"
 #include "mpi/tile_server.hpp"
 #include "parallel/parallel_pull.hpp"
 #include "render/render_tile.hpp"
@@ -76,11 +77,11 @@ std::string settings_fingerprint(const Setup& s, const driver::RenderArgs& args)
   f << "--width " << r.width << "\n--height " << r.height << "\n--integrator "
     << name_of<Integrator>(kIntegratorNames, r.integrator) << "\n--spp " << r.spp << "\n--max-depth " << r.max_depth
     << "\n--ao " << r.ao_samples << "\n--ao-distance " << r.ao_distance << "\n--ambient " << r.ambient << "\n--seed "
-    << r.seed << "\n--light-sampling " << name_of<LightSampling>(kLightSamplingNames, r.light_sampling) << "\n--env "
-    << vec(r.environment) << "\n--env-map " << args.scene.env_map << "\n--env-rotation " << args.scene.env_rotation
-    << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up " << vec(s.camera.up)
-    << "\n--fov " << s.camera.fov_degrees << "\n--frames " << args.frames << "\n--orbit " << args.orbit
-    << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
+    << r.seed << "\n--light-sampling " << name_of<LightSampling>(kLightSamplingNames, r.light_sampling)
+    << "\n--env-map " << args.scene.env_map << "\n--env-rotation " << args.scene.env_rotation << "\n--env "
+    << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
+    << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--frames " << args.frames << "\n--orbit "
+    << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
     << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block
     << "\n";
   return f.str();
@@ -168,7 +169,8 @@ constexpr const char* kStopMessage =
 
 // `parse_error`: this rank's flags did not parse (exit code 2 and the message); it still joins the
 // first collective, so rank 0 can name it and end the job instead of waiting for it.
-int run(const driver::RenderArgs& args, MpiSession& session, const std::string& parse_error, double rank_timeout) {
+int run(const driver::RenderArgs& args, MpiSession& session, const std::string& parse_error, double rank_timeout,
+        PhaseWatch& watch_phase) {
   driver::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
   const ThreadLimit thread_limit(args.threads.value_or(0));
   // Built in place, never moved: the accelerator points into the scene.
@@ -183,6 +185,8 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const std::vector<std::string> errors =
       session.gather_strings(setup.error.empty() ? "" : std::to_string(setup.exit_code) + " " + setup.error);
   const std::vector<uint64_t> checksums = session.all_gather(setup.error.empty() ? scene_checksum(*setup.scene) : 0);
+  const std::vector<uint64_t> environments =
+      session.all_gather(setup.error.empty() ? environment_checksum(setup.scene->environment_map) : 0);
   const int threads = setup.error.empty() ? thread_count(setup.sched) : 0;
   const std::vector<uint64_t> all_threads = session.all_gather(uint64_t(threads));
   const std::vector<std::string> fingerprints = session.gather_strings(setup.fingerprint);
@@ -212,6 +216,14 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
         verdict = 1;
       }
     }
+    for (int r = 1; r < session.size() && verdict == 0; ++r) {
+      if (environments[size_t(r)] != environments[0]) {
+        say("tracer-mpi: error: rank " + std::to_string(r) + " of " + std::to_string(session.size()) +
+            " read a different environment map than rank 0 (--env-map '" + args.scene.env_map +
+            "' on rank 0): every rank must read the same file, or none");
+        verdict = 1;
+      }
+    }
     // After the scene: another scene frames another default camera.
     for (int r = 1; r < session.size() && verdict == 0; ++r) {
       const auto [ours, theirs] = first_difference(fingerprints[0], fingerprints[size_t(r)]);
@@ -222,6 +234,7 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
     }
   }
   verdict = session.broadcast(verdict);
+  watch_phase.disarm();  // start-up is over: every rank answered
   if (verdict != 0) {
     // The first rank to exit non-zero makes mpirun stop the others with SIGTERM: rank 0 has said
     // what is wrong, so that signal needs no second message.
@@ -250,7 +263,8 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
     progress.emplace(!args.quiet, work, pixels_done, rays_done);
   }
   std::mutex report_mutex;
-  uint32_t round_serial = 0;  // rounds over all frames, for their messages' tags
+  std::atomic<double> slowest_tile_s{0.0};  // this rank's slowest tile so far
+  uint32_t round_serial = 0;                // rounds over all frames, for their messages' tags
   const auto render_round = [&](const RenderContext& ctx, const std::vector<SampleRange>& round) {
     ++round_serial;
     const uint32_t first = round.front().first, samples = round.back().first + round.back().count - first;
@@ -300,6 +314,14 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
       return true;
     }
     TileClient client(tiles, round_serial);
+    // Rank 0 answers a request at once, or, between rounds, once the round is in: within the time
+    // it gives a late rank (overdue_after()) and the rendering of that rank's tiles. Twice that
+    // without an answer, rank 0 itself has stopped.
+    const auto answer_bound = [&] { return 2.0 * std::max(rank_timeout, 8.0 * slowest_tile_s.load()); };
+    watch_phase.arm("tracer-mpi: error: rank " + std::to_string(session.rank()) + " of " +
+                        std::to_string(session.size()) + ": rank 0 stopped answering (no answer within " +
+                        std::to_string(int(answer_bound())) + " s); ending the job",
+                    answer_bound());
     try {
       // Each thread renders its tiles into windows of its own and sends them back; its next
       // request is already in flight while it renders.
@@ -312,7 +334,12 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
         while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
           const Tile& t = tiles[*next];
           result = std::make_unique<Framebuffer>(t);
+          const auto t0 = Clock::now();
           count(render_one(accel, ctx, round, *result, t), t);
+          const double took = ms_since(t0) * 1e-3;
+          for (double seen = slowest_tile_s.load(); took > seen && !slowest_tile_s.compare_exchange_weak(seen, took);) {
+          }
+          watch_phase.progress(answer_bound());
           finished = *next;
         }
         std::lock_guard lock(report_mutex);
@@ -355,6 +382,12 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   }
   if (progress) progress->stop();
   mine.render_ms = ms_since(t_render);
+  // The statistics: every rank answers once rank 0 has written the image.
+  const double gather_bound = 2.0 * std::max(rank_timeout, 8.0 * slowest_tile_s.load()) + 60.0;
+  watch_phase.arm("tracer-mpi: error: rank " + std::to_string(session.rank()) + " of " +
+                      std::to_string(session.size()) + ": the ranks' statistics did not arrive within " +
+                      std::to_string(int(gather_bound)) + " s (a rank stopped answering); ending the job",
+                  gather_bound);
   mine.rays = counts.load().total();
 
   // Statistics: every rank's tiles, rays and idle time, on rank 0.
@@ -369,6 +402,7 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const std::vector<uint64_t> rays = session.all_gather(mine.rays);
   const std::vector<uint64_t> idle_us = session.all_gather(uint64_t(mine.idle_ms * 1e3));
   const std::vector<uint64_t> render_us = session.all_gather(uint64_t(mine.render_ms * 1e3));
+  watch_phase.disarm();
   if (session.root()) {
     nlohmann::json stats =
         driver::render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, mine.render_ms, total);
@@ -413,6 +447,19 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
 
 int main(int argc, char** argv) {
   using namespace tracer;
+  // Start-up (MPI's, the scene's loading, the agreement on the setup) has a bound of its own from
+  // the first instant, MPI_Init included: a rank that never gets there ends the job, named.
+  double startup_timeout = 120.0;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::string(argv[i]) == "--startup-timeout") startup_timeout = std::atof(argv[i + 1]);
+  }
+  if (!(startup_timeout >= 0.1 && startup_timeout <= 1e6)) startup_timeout = 120.0;  // CLI11 says what is wrong
+  mpi::PhaseWatch watch;
+  watch.arm("tracer-mpi: error: rank " + mpi::launcher_rank_text() + ": start-up did not end within " +
+                std::to_string(int(startup_timeout)) +
+                " s (MPI start-up, loading the scene, agreeing on the setup): a rank stopped or cannot be reached "
+                "(--startup-timeout raises it); ending the job",
+            startup_timeout);
   std::optional<mpi::MpiSession> session;
   try {
     session.emplace(argc, argv);
@@ -438,6 +485,11 @@ int main(int argc, char** argv) {
                    "tile so far if more)")
       ->check(CLI::Range(0.1, 1e6))
       ->capture_default_str();
+  render
+      ->add_option("--startup-timeout", startup_timeout,
+                   "seconds every rank may take to start, load the scene and agree on the setup")
+      ->check(CLI::Range(0.1, 1e6))
+      ->capture_default_str();
   std::string parse_error;
   try {
     app.parse(argc, argv);
@@ -446,7 +498,7 @@ int main(int argc, char** argv) {
     parse_error = std::string(e.what()) + " (see tracer-mpi --help)";
   }
   try {
-    return mpi::run(args, *session, parse_error, rank_timeout);
+    return mpi::run(args, *session, parse_error, rank_timeout, watch);
   } catch (const std::exception& e) {
     mpi::say("tracer-mpi: error: rank " + std::to_string(session->rank()) + ": " + e.what());
     MPI_Abort(MPI_COMM_WORLD, 1);

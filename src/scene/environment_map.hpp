@@ -32,6 +32,8 @@ class EnvironmentMap {
   size_t clamped_values() const { return clamped_; }
   // Whether no texel gives light: the map lights nothing.
   bool black() const { return black_; }
+  const std::vector<Vec3>& texels() const { return texels_; }
+  float rotation_turns() const { return rotation_; }
   int width() const { return width_; }
   int height() const { return height_; }
   Vec3 radiance(Vec3 dir) const;

@@ -65,4 +65,13 @@ uint64_t scene_checksum(const Scene& scene) {
   return h.get();
 }
 
+uint64_t environment_checksum(const EnvironmentMap& map) {
+  Fnv1a h;
+  h.value(map.width());
+  h.value(map.height());
+  h.value(map.rotation_turns());
+  h.array(map.texels());
+  return h.get();
+}
+
 }  // namespace tracer
