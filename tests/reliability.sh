@@ -204,7 +204,6 @@ cases=(
   "tracer-mpi: one rank refuses a flag (an older binary)|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png --newer-flag|2"
   "tracer-mpi: ranks given different --width|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 64 --height 32 -o m.png|2"
   "tracer-mpi: rank 0 stopped (SIGSTOP) mid-render|stall_rank 0 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 4096 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m0.png|1"
-  "tracer-mpi: rank 1 stopped (SIGSTOP) in start-up|stall_rank 1 --at-start $MPIRUN -np 3 tracer-mpi render -q --integrator ao --width 32 --height 32 --startup-timeout 3 -o m1.png|1"
   "tracer-mpi: one --env-map path, two files (other working directories)|$MPIRUN -np 1 -wdir envA tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png : -np 1 -wdir envB tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png|1"
   "tracer-mpi: rank 1 stopped (SIGSTOP) mid-render|stall_rank 1 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 1024 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m.png|1"
 )
