@@ -114,6 +114,31 @@ stall_rank() {
   wait "$job"
 }
 export -f stall_rank
+# view_request REQUEST: starts `tracer view ok.obj` on a free port, sends REQUEST (PORT and TOKEN
+# replaced by the viewer's) over a raw connection, and writes the answer's status line and its
+# error message to stderr (the table's column); the viewer is then stopped.
+view_request() {
+  local out port token
+  out=$(mktemp)
+  "$TRACER_BIN" view ok.obj --port 0 -q > "$out" 2>/dev/null &
+  local viewer=$!
+  for _ in $(seq 200); do grep -q 'token=' "$out" && break; sleep 0.05; done
+  port=$(sed -E 's|.*:([0-9]+)/.*|\1|' "$out")
+  token=$(sed -E 's|.*token=([0-9a-f]+).*|\1|' "$out")
+  local request=${1//PORT/$port}
+  request=${request//TOKEN/$token}
+  exec 3<>"/dev/tcp/127.0.0.1/$port"
+  printf '%b' "$request" >&3
+  local answer
+  answer=$(timeout 5 cat <&3 | tr -d '\r')
+  exec 3<&-
+  kill -INT "$viewer"
+  wait "$viewer" 2>/dev/null
+  rm -f "$out"
+  echo "$(head -n 1 <<< "$answer"): $(tail -n 1 <<< "$answer")" >&2
+}
+export -f view_request
+export TRACER_BIN=$tracer
 SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
 PATH_RENDER="render ok.obj -q --integrator path --spp 1000000 --width 128 --height 128 -o out.png"
 
@@ -153,6 +178,10 @@ cases=(
   "tracer view: --listen ''|tracer view ok.obj --listen '' -q|2"
   "tracer view: --listen 0.0.0.0 (beyond this machine), then Ctrl-C|timeout --foreground --preserve-status -s INT 2 tracer view ok.obj --listen 0.0.0.0 --port 0 -q > /dev/null|130"
   "tracer view: the port already served by another viewer|(timeout -s INT 3 tracer view ok.obj --port 18734 -q > /dev/null 2>&1 &) ; sleep 1.5 ; tracer view ok.obj --port 18734 -q|2"
+  "tracer view: a chunked POST to /control (the 4 KiB limit held)|view_request 'POST /control?token=TOKEN HTTP/1.1\\r\\nHost: 127.0.0.1:PORT\\r\\nContent-Type: application/json\\r\\nTransfer-Encoding: chunked\\r\\n\\r\\n2\\r\\n{}\\r\\n0\\r\\n\\r\\n'|0"
+  "tracer view: a POST without Content-Length|view_request 'POST /control?token=TOKEN HTTP/1.1\\r\\nHost: 127.0.0.1:PORT\\r\\nContent-Type: application/json\\r\\n\\r\\n'|0"
+  "tracer view: Host evil.example (DNS rebinding), with the token|view_request 'GET /state?token=TOKEN HTTP/1.1\\r\\nHost: evil.example:PORT\\r\\n\\r\\n'|0"
+  "tracer view: the token twice, the second wrong|view_request 'GET /state?token=TOKEN&token=bad HTTP/1.1\\r\\nHost: 127.0.0.1:PORT\\r\\n\\r\\n'|0"
   "tracer view: a render flag it has no use for|tracer view ok.obj --frames 3 -q|2"
   "tracer view: Ctrl-C (SIGINT) while serving|timeout --foreground --preserve-status -s INT 2 tracer view ok.obj --port 0 -q|130"
   "--spp with --integrator ao (anti-aliasing)|tracer render --integrator ao --spp 4 -q --width 8 --height 8 -o a.png|0"

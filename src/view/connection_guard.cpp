@@ -100,7 +100,7 @@ HeadCheck check_head(std::string_view head, const std::string& token, int port, 
     const bool ours = host.size() > suffix.size() &&
                       host.compare(host.size() - suffix.size(), suffix.size(), suffix) == 0 &&
                       is_loopback_host(host.substr(0, host.size() - suffix.size()));
-    if (!ours) return {403, "Host '" + host + "' is not this viewer's address"};
+    if (!ours) return {403, "Host '" + host.substr(0, host.rfind(':')) + "' is not this viewer's address"};
   }
   if (!origin.empty() && origin != "http://" + host) return {403, "Origin '" + origin + "' is not this viewer's page"};
   if (!transfer_encoding.empty()) return {400, "Transfer-Encoding is not accepted: send a Content-Length"};
