@@ -54,7 +54,7 @@ void remember_input(const struct stat& st, const std::string& name) {
 
 std::string mib(uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 
-InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_bytes, bool map) {
+InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_bytes, bool map, bool remember = true) {
   const bool stdin_input = path == "-";
   const std::string name = stdin_input ? "<stdin>" : path;
   if (path.empty()) throw InputError("an empty file name was given");
@@ -81,7 +81,7 @@ InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_
     return InputTooLarge(name + ": larger than " + mib(max_bytes) + ", the limit for this input (README: Limits)");
   };
   if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes) throw too_large();
-  remember_input(st, name);
+  if (remember) remember_input(st, name);
   if (map && S_ISREG(st.st_mode) && st.st_size > 0) {
     void* mapping = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
     if (mapping != MAP_FAILED) return InputBytes(static_cast<const char*>(mapping), size_t(st.st_size));
@@ -140,6 +140,10 @@ std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_
 
 InputBytes map_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
   return read_or_map(path, cancel, max_bytes, true);
+}
+
+std::string read_back(const std::string& path, uint64_t max_bytes) {
+  return read_or_map(path, nullptr, max_bytes, false, false).release();
 }
 
 void check_not_an_input(const std::string& path, const std::string& flag) {

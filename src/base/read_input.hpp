@@ -53,6 +53,10 @@ class InputBytes {
   size_t size_ = 0;
 };
 
+// As read_input(), for a file that is no input of the run: one it wrote and reads back (tests),
+// which it may write again.
+std::string read_back(const std::string& path, uint64_t max_bytes = kDefaultMaxInputBytes);
+
 // As read_input(), mapping a regular file instead of reading it.
 InputBytes map_input(const std::string& path, CancelFlag cancel = nullptr, uint64_t max_bytes = kDefaultMaxInputBytes);
 

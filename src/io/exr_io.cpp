@@ -198,7 +198,7 @@ Framebuffer decode_exr(std::string_view bytes, const std::string& path, const Ex
 }
 
 Framebuffer read_exr(const std::string& path, const ExrLayer& layer) {
-  return decode_exr(read_input(path), path, layer);
+  return decode_exr(read_back(path), path, layer);
 }
 
 }  // namespace tracer

@@ -36,6 +36,7 @@ ImageSize exr_size(std::string_view bytes, const std::string& path);
 // as encode_exr writes them). Throws InputError: unreadable, too large (kMaxImagePixels), or
 // truncated, refused before the pixels are allocated.
 Framebuffer decode_exr(std::string_view bytes, const std::string& path, const ExrLayer& layer = {});
+// read_exr: the same from a file, which stays writable by this run (read_back()).
 Framebuffer read_exr(const std::string& path, const ExrLayer& layer = {});
 
 }  // namespace tracer

@@ -238,6 +238,6 @@ Image8 decode_image(std::string_view bytes, const std::string& path) {
   return img;
 }
 
-Image8 read_image(const std::string& path) { return decode_image(read_input(path), path); }
+Image8 read_image(const std::string& path) { return decode_image(read_back(path), path); }
 
 }  // namespace tracer

@@ -51,7 +51,8 @@ void check_output(const std::string& path, const std::string& flag);
 // Where a write to `path` lands: symbolic links followed (the target may not exist yet).
 std::string resolve_output(const std::string& path);
 
-// Reads a PNG or PPM written by write_image (tests, image comparison); throws InputError.
+// Reads a PNG or PPM written by write_image (tests), which stays writable by this run
+// (read_back()); throws InputError.
 Image8 read_image(const std::string& path);
 // The same from bytes in memory, and the size alone from the header (refused past
 // kMaxImagePixels); both throw InputError naming `path`.
