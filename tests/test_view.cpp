@@ -340,21 +340,25 @@ TEST_F(ViewServerTest, SlowConnectionsDoNotStarveTheRealClient) {
   std::vector<std::thread> slow;
   for (int i = 0; i < 50; ++i) {
     slow.emplace_back([&, i] {
+      // Each connection trickles a header line a second for as long as the server takes them
+      // (cpp-httplib's per-read timeout, 5 s, never trips), then the next one comes.
       while (!stop) {
         RawConnection c(port_);
-        if (!c.send("GET /state HTTP/1.1\r\n")) continue;
-        for (int line = 0; line < 40 && !stop && c.send("X-Slow-" + std::to_string(i) + ": 1\r\n"); ++line) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        if (c.send("GET /state HTTP/1.1\r\n")) {
+          while (!stop && c.send("X-Slow-" + std::to_string(i) + ": 1\r\n")) {
+            for (int k = 0; k < 10 && !stop; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          }
         }
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
     });
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // every slow connection is in
   int answered = 0;
   for (int i = 0; i < 10; ++i) {
     httplib::Client c = client();
-    c.set_read_timeout(3, 0);
-    c.set_connection_timeout(3, 0);
+    c.set_read_timeout(5, 0);
+    c.set_connection_timeout(5, 0);
     const auto r = c.Get(with_token("/state").c_str());
     answered += r && r->status == 200 ? 1 : 0;
   }
