@@ -153,16 +153,6 @@ class WarningLog {
     if (inserted) entries_.push_back({message, 0});
     ++entries_[it->second].count;
   }
-  void add_lines(const std::string& text) {
-    size_t begin = 0;
-    while (begin < text.size()) {
-      size_t end = text.find('\n', begin);
-      if (end == std::string::npos) end = text.size();
-      const std::string_view line = trim(std::string_view(text).substr(begin, end - begin));
-      if (!line.empty()) add(std::string(line));
-      begin = end + 1;
-    }
-  }
   void flush(const std::string& name, const WarningSink& sink) const {
     for (const Entry& e : entries_) {
       std::string line = name + ": " + escaped(e.first);
