@@ -249,6 +249,17 @@ std::pair<int, double> wait_at_most(pid_t pid, double limit, const std::string& 
   }
 }
 
+// Stops `victim` (SIGSTOP) and waits, at most 120 s, for the job `launcher` runs to end; then
+// continues and kills it. The job's exit code (-1 if it did not end) and its output.
+test::CommandResult stopped_until_the_job_ends(pid_t launcher, pid_t victim, const std::string& log,
+                                               const std::string& dir) {
+  ::kill(victim, SIGSTOP);
+  const auto [code, seconds] = wait_at_most(launcher, 120, dir);
+  ::kill(victim, SIGCONT);
+  ::kill(victim, SIGKILL);
+  return {code, read_file(log)};
+}
+
 // A long path render on three ranks, and the pid of the process running rank `rank` once it runs.
 pid_t start_long_job(const std::string& dir, const std::string& log, int rank, pid_t& launcher) {
   launcher = launch(mpirun(3) + kMpiExe + " render --integrator path --spp 1000000 --width 64 --height 64 -q " +
@@ -440,11 +451,7 @@ TEST_F(MpiRender, AStalledRankZeroEndsTheJobNamed) {
     if (pids.size() == 1 && fs::exists(image)) victim = pids[0];
   }
   ASSERT_GT(victim, 0) << read_file(log);
-  ::kill(victim, SIGSTOP);
-  const auto [code, seconds] = wait_at_most(launcher, 120, dir_);
-  ::kill(victim, SIGCONT);
-  ::kill(victim, SIGKILL);
-  const std::string text = read_file(log);
+  const auto [code, text] = stopped_until_the_job_ends(launcher, victim, log, dir_);
   EXPECT_NE(code, 0) << text;
   EXPECT_NE(code, -1) << "the job did not end by itself: " << text;
   EXPECT_NE(text.find("tracer-mpi: error: rank 1 of 2: rank 0 stopped answering (no answer within"), std::string::npos)
@@ -467,11 +474,7 @@ TEST_F(MpiRender, ARankStalledInStartUpEndsTheJob) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   ASSERT_GT(victim, 0) << read_file(log);
-  ::kill(victim, SIGSTOP);
-  const auto [code, seconds] = wait_at_most(launcher, 120, dir_);
-  ::kill(victim, SIGCONT);
-  ::kill(victim, SIGKILL);
-  const std::string text = read_file(log);
+  const auto [code, text] = stopped_until_the_job_ends(launcher, victim, log, dir_);
   EXPECT_NE(code, 0) << text;
   EXPECT_NE(code, -1) << "the job did not end by itself: " << text;
   EXPECT_NE(text.find("start-up did not end within 5 s"), std::string::npos) << text;
