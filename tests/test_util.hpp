@@ -20,6 +20,15 @@ std::vector<Ray> random_rays(const Scene& scene, size_t count, uint32_t seed);
 // How many rays a test should trace: TRACER_TEST_RAYS overrides `dflt` (sanitizer runs lower it).
 size_t ray_budget(size_t dflt);
 
+// Whether the tests (and the binaries they run) are built with a sanitizer: memory and time are
+// then the sanitizer's (shadow memory, a quarantine, slower threads), so a test that bounds them
+// skips that bound.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kUnderSanitizer = true;
+#else
+inline constexpr bool kUnderSanitizer = false;
+#endif
+
 struct CommandResult {
   int exit_code;
   std::string output;  // stdout and stderr together
