@@ -59,6 +59,9 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n' > range.obj
 printf '# nothing\n' > empty.obj
 printf 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n' > same.obj
 printf 'v 0 0 0\nv 1e-30 0 0\nv 0 1e-30 0\nf 1 2 3\n' > tiny.obj
+printf 'mtllib ihdr.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a\nf 1 2 3\n' > ihdr.obj
+printf 'newmtl a\nmap_Kd ihdr.png\n' > ihdr.mtl
+printf '\211PNG\r\n\032\n\000\000\000\rIHDR\000\000\000\010\000\000\000\010\010\002\000\000\000\113\155\051\336' > ihdr.png
 printf 'v 0 0 0\nv 1\001 0 0\nv 0 1 0\nf 1 2 3\n' > control.obj
 printf '\357\273\277v 0 0 0\nv +1 0 1e-50\nv 0 1 0\nf 1 2 3\n' > bom.obj
 { printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n'; for i in $(seq 20000); do printf 'usemtl undefined%d\nf 1 2 3\n' "$i"; done; } > materials.obj
@@ -138,6 +141,35 @@ view_request() {
   echo "$(head -n 1 <<< "$answer"): $(tail -n 1 <<< "$answer")" >&2
 }
 export -f view_request
+# slow_clients: fifty connections to `tracer view` trickling a header line a second (no token),
+# then a real request; its status line goes to stderr.
+slow_clients() {
+  local out port token
+  out=$(mktemp)
+  "$TRACER_BIN" view ok.obj --port 0 -q > "$out" 2>/dev/null &
+  local viewer=$!
+  for _ in $(seq 200); do grep -q 'token=' "$out" && break; sleep 0.05; done
+  port=$(sed -E 's|.*:([0-9]+)/.*|\1|' "$out")
+  token=$(sed -E 's|.*token=([0-9a-f]+).*|\1|' "$out")
+  local slow=()
+  for _ in $(seq 50); do
+    (exec 3<>"/dev/tcp/127.0.0.1/$port" && printf 'GET /state HTTP/1.1\r\n' >&3 &&
+      for _ in $(seq 8); do printf 'X-Slow: 1\r\n' >&3 || break; sleep 1; done) 2>/dev/null &
+    slow+=($!)
+  done
+  sleep 1.5
+  exec 3<>"/dev/tcp/127.0.0.1/$port"
+  printf 'GET /state?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%s\r\nConnection: close\r\n\r\n' "$token" "$port" >&3
+  local answer
+  answer=$(timeout 5 head -n 1 <&3 | tr -d '\r')
+  exec 3<&-
+  kill "${slow[@]}" 2>/dev/null
+  kill -INT "$viewer"
+  wait "$viewer" 2>/dev/null
+  rm -f "$out"
+  echo "${answer:-no answer within 5 s}" >&2
+}
+export -f slow_clients
 export TRACER_BIN=$tracer
 SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
 PATH_RENDER="render ok.obj -q --integrator path --spp 1000000 --width 128 --height 128 -o out.png"
@@ -182,6 +214,7 @@ cases=(
   "tracer view: a POST without Content-Length|view_request 'POST /control?token=TOKEN HTTP/1.1\\r\\nHost: 127.0.0.1:PORT\\r\\nContent-Type: application/json\\r\\n\\r\\n'|0"
   "tracer view: Host evil.example (DNS rebinding), with the token|view_request 'GET /state?token=TOKEN HTTP/1.1\\r\\nHost: evil.example:PORT\\r\\n\\r\\n'|0"
   "tracer view: the token twice, the second wrong|view_request 'GET /state?token=TOKEN&token=bad HTTP/1.1\\r\\nHost: 127.0.0.1:PORT\\r\\n\\r\\n'|0"
+  "tracer view: fifty connections trickling header lines, then a real request|slow_clients|0"
   "tracer view: a render flag it has no use for|tracer view ok.obj --frames 3 -q|2"
   "tracer view: Ctrl-C (SIGINT) while serving|timeout --foreground --preserve-status -s INT 2 tracer view ok.obj --port 0 -q|130"
   "--spp with --integrator ao (anti-aliasing)|tracer render --integrator ao --spp 4 -q --width 8 --height 8 -o a.png|0"
@@ -228,11 +261,13 @@ cases=(
   "an empty scene name|tracer render '' -q|2"
   "an unknown --view|tracer render --view unknown --views tri-views.tsv -q|2"
   "--integrator whitted --spp 4|tracer render --integrator whitted --spp 4 -q --width 8 --height 8 -o w.png|0"
+  "a texture of only its IHDR chunk|tracer render ihdr.obj --width 8 --height 8 -o i.png|0"
   "a texture claiming 16384x16384 texels|tracer render bomb.obj --width 8 --height 8 -o b.png|0"
   "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
   "tracer-mpi: one rank refuses a flag (an older binary)|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png --newer-flag|2"
   "tracer-mpi: ranks given different --width|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 64 --height 32 -o m.png|2"
   "tracer-mpi: rank 0 stopped (SIGSTOP) mid-render|stall_rank 0 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 4096 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m0.png|1"
+  "tracer-mpi: rank 1 stopped (SIGSTOP) in start-up (the job fails: exit 0 here)|! stall_rank 1 --at-start $MPIRUN -np 3 tracer-mpi render -q --integrator ao --width 32 --height 32 --startup-timeout 3 -o m1.png|0"
   "tracer-mpi: one --env-map path, two files (other working directories)|$MPIRUN -np 1 -wdir envA tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png : -np 1 -wdir envB tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png|1"
   "tracer-mpi: rank 1 stopped (SIGSTOP) mid-render|stall_rank 1 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 1024 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m.png|1"
 )
@@ -250,7 +285,7 @@ for c in "${cases[@]}"; do
   # tracer's own first line (mpirun's banners may come first); the bound tracer-mpi derives from
   # measured tile times is shown as N too.
   first=$(printf '%s\n' "$stderr" | grep -m 1 '^tracer' || printf '%s\n' "$stderr" | head -n 1)
-  first=$(printf '%s\n' "$first" | sed -E 's/after [0-9]+ of/after N of/; s/within [0-9]+ s/within N s/')
+  first=$(printf '%s\n' "$first" | sed -E 's/after [0-9]+ of/after N of/; s/within [0-9]+ s/within N s/; s/rank [0-9]+ of ([0-9]+): start-up/rank N of \1: start-up/')
   [[ -z $first ]] && first="(nothing)"
   left=$(comm -13 <(echo "$inputs") <(ls) | tr '\n' ' ')
   left=${left% }
