@@ -44,6 +44,28 @@ for i in $(seq 13); do cat rows.bin rows.bin > rows2.bin && mv rows2.bin rows.bi
 mkdir envA envB
 "$tracer" render -q --integrator ao --ao 0 --width 8 --height 4 -o envA/sky.exr
 "$tracer" render -q --integrator ao --ao 0 --width 16 --height 8 -o envB/sky.exr
+# png16 W H: a 16-bit RGB PNG of W x H black texels on stdout (zlib by gzip: all-zero rows, so
+# the Adler-32 is (len mod 65521) << 16 | 1; the chunk CRCs are gzip's CRC-32 of each chunk).
+png16() {
+  local w=$1 h=$2 tmp
+  tmp=$(mktemp -d)
+  be32() { printf "\\$(printf '%03o' $(( ($1 >> 24) & 255 )))\\$(printf '%03o' $(( ($1 >> 16) & 255 )))\\$(printf '%03o' $(( ($1 >> 8) & 255 )))\\$(printf '%03o' $(( $1 & 255 )))"; }
+  crc_of() { gzip -c < "$1" | tail -c 8 | head -c 4 | od -An -tu4 | tr -d ' '; }
+  chunk() {  # type data-file
+    printf '%s' "$1" > "$tmp/c"; cat "$2" >> "$tmp/c"
+    be32 "$(stat -c %s "$2")"; cat "$tmp/c"; be32 "$(crc_of "$tmp/c")"
+  }
+  { be32 "$w"; be32 "$h"; printf '\020\002\000\000\000'; } > "$tmp/ihdr"
+  local raw=$(( (w * 6 + 1) * h ))
+  { printf '\170\234'; head -c "$raw" /dev/zero | gzip -9 -n | tail -c +11 | head -c -8; be32 $(( ((raw % 65521) << 16) | 1 )); } > "$tmp/idat"
+  : > "$tmp/iend"
+  printf '\211PNG\r\n\032\n'; chunk IHDR "$tmp/ihdr"; chunk IDAT "$tmp/idat"; chunk IEND "$tmp/iend"
+  rm -rf "$tmp"
+}
+# Twelve 16-bit 4096^2 textures (stb_image decodes each through ~400 MB of buffers).
+png16 4096 4096 > t0.png
+{ printf 'mtllib many.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n'; for i in $(seq 0 11); do printf 'usemtl m%d\nf 1/1 2/2 3/3\n' "$i"; done; } > many.obj
+for i in $(seq 0 11); do [[ $i -gt 0 ]] && cp t0.png "t$i.png"; printf 'newmtl m%d\nmap_Kd t%d.png\n' "$i" "$i"; done > many.mtl
 mkdir viewsdir
 printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n' > viewsdir/tri.obj
 printf 'scene\tobj\teye\tlook\tup\tfov\tlight\ntri\ttri.obj\t0,0,3\t0,0\n' > viewsdir/views.tsv
@@ -170,6 +192,13 @@ slow_clients() {
   echo "${answer:-no answer within 5 s}" >&2
 }
 export -f slow_clients
+# peak_below JSON MIB: fails, saying so, if the --stats-json file's peak_rss_mib is MIB or more.
+peak_below() {
+  local peak
+  peak=$(sed -nE 's/.*"peak_rss_mib": ([0-9.]+).*/\1/p' "$1")
+  awk -v p="$peak" -v m="$2" 'BEGIN { exit !(p < m) }' || { echo "peak memory $peak MiB, not below $2" >&2; return 1; }
+}
+export -f peak_below
 export TRACER_BIN=$tracer
 SLOW="render slow.obj -q --accel brute --width 2048 --height 2048 -o out.png"
 PATH_RENDER="render ok.obj -q --integrator path --spp 1000000 --width 128 --height 128 -o out.png"
@@ -261,6 +290,7 @@ cases=(
   "an empty scene name|tracer render '' -q|2"
   "an unknown --view|tracer render --view unknown --views tri-views.tsv -q|2"
   "--integrator whitted --spp 4|tracer render --integrator whitted --spp 4 -q --width 8 --height 8 -o w.png|0"
+  "twelve 16-bit 4096x4096 textures under --max-texture-mib 512: peak memory below 672 MiB|tracer render many.obj --max-texture-mib 512 --threads 2 --integrator ao --width 8 --height 8 -o many.png --stats-json many.json && peak_below many.json 672|0"
   "a texture of only its IHDR chunk|tracer render ihdr.obj --width 8 --height 8 -o i.png|0"
   "a texture claiming 16384x16384 texels|tracer render bomb.obj --width 8 --height 8 -o b.png|0"
   "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
