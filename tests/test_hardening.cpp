@@ -1,6 +1,6 @@
 // Hostile inputs and outputs (docs/RELIABILITY.md): outputs that are device nodes, FIFOs,
 // symbolic links or inputs; coordinates at the edge of the accepted range; inputs that never end;
-// texture decompression bombs; black images; anti-aliasing for every integrator.
+// texture decompression bombs; black images.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -333,25 +333,6 @@ TEST_F(Hardening, ABlackImageIsNeverSilent) {
 }
 
 // --spp anti-aliases ao and whitted too, the same image whatever the threads, scheduler and tiles.
-TEST(AntiAliasing, EveryIntegratorTakesSamplesPerPixelDeterministically) {
-  const std::string dir = test::temp_dir();
-  for (const char* integrator : {"ao", "whitted"}) {
-    SCOPED_TRACE(integrator);
-    const std::string base = std::string("render -q --width 24 --height 20 --integrator ") + integrator;
-    const auto a = test::run_tracer(base + " --spp 4 --threads 1 --sched seq -o " + dir + "/a.ppm");
-    const auto b = test::run_tracer(base + " --spp 4 --threads 2 --sched tbb --tile 7 -o " + dir + "/b.ppm");
-    const auto c = test::run_tracer(base + " --spp 4 --threads 2 --sched async -o " + dir + "/c.ppm");
-    const auto one = test::run_tracer(base + " --spp 1 -o " + dir + "/one.ppm");
-    const auto centre = test::run_tracer(base + " -o " + dir + "/centre.ppm");
-    for (const auto* r : {&a, &b, &c, &one, &centre}) ASSERT_EQ(r->exit_code, 0) << r->output;
-    EXPECT_EQ(slurp(dir + "/a.ppm"), slurp(dir + "/b.ppm"));
-    EXPECT_EQ(slurp(dir + "/a.ppm"), slurp(dir + "/c.ppm"));
-    EXPECT_EQ(slurp(dir + "/one.ppm"), slurp(dir + "/centre.ppm"));  // one sample: the pixel centre
-    EXPECT_NE(slurp(dir + "/a.ppm"), slurp(dir + "/one.ppm"));       // four: edges are smoothed
-  }
-  fs::remove_all(dir);
-}
-
 TEST_F(Hardening, ABrokenViewsFileBesideTheSceneIsAWarning) {
   std::ofstream(in("views.tsv")) << "scene\tobj\teye\tlook\tup\tfov\tlight\n"
                                  << "tri\ttri.obj\t0,0,3\t0,0\n";
@@ -374,31 +355,5 @@ TEST_F(Hardening, FrameNamesSortInFrameOrderPastTenThousand) {
 
 // Textures read and decoded on several threads give the scene one thread gives, and the total
 // budget leaves out the same textures.
-TEST(ParallelTextures, TheSameSceneAsOneThread) {
-  if (!test::have_shared_scenes()) GTEST_SKIP() << "needs ../shared/scenes";
-  const std::string path = test::scene_path("sponza/sponza.obj");
-  const Executor executor(Strategy::Tbb, 2);
-  for (const uint64_t budget : {uint64_t(2048) << 20, uint64_t(2) << 20}) {
-    LoadLimits one, many;
-    one.textures.max_total_bytes = many.textures.max_total_bytes = budget;
-    many.for_each = [&](size_t count, const std::function<void(size_t)>& body) { executor.for_each(count, body); };
-    std::vector<std::string> w1, w2;
-    const Scene a = load_obj(
-        path, [&](const std::string& w) { w1.push_back(w); }, nullptr, one);
-    const Scene b = load_obj(
-        path, [&](const std::string& w) { w2.push_back(w); }, nullptr, many);
-    EXPECT_EQ(w1, w2);
-    ASSERT_EQ(a.textures.size(), b.textures.size());
-    for (size_t t = 0; t < a.textures.size(); ++t) EXPECT_EQ(a.textures[t].srgb(), b.textures[t].srgb()) << t;
-    ASSERT_EQ(a.materials.size(), b.materials.size());
-    for (size_t m = 0; m < a.materials.size(); ++m) {
-      EXPECT_EQ(a.materials[m].diffuse_texture, b.materials[m].diffuse_texture) << m;
-    }
-    if (budget < (uint64_t(100) << 20)) {
-      EXPECT_FALSE(w1.empty());  // some textures left out, and said
-    }
-  }
-}
-
 }  // namespace
 }  // namespace tracer

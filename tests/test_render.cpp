@@ -292,5 +292,30 @@ TEST(Exr, TheCliWritesTheRadianceThePngToneMaps) {
   std::filesystem::remove_all(dir);
 }
 
+// Every byte of a file (the images compared below).
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(AntiAliasing, EveryIntegratorTakesSamplesPerPixelDeterministically) {
+  const std::string dir = test::temp_dir();
+  for (const char* integrator : {"ao", "whitted"}) {
+    SCOPED_TRACE(integrator);
+    const std::string base = std::string("render -q --width 24 --height 20 --integrator ") + integrator;
+    const auto a = test::run_tracer(base + " --spp 4 --threads 1 --sched seq -o " + dir + "/a.ppm");
+    const auto b = test::run_tracer(base + " --spp 4 --threads 2 --sched tbb --tile 7 -o " + dir + "/b.ppm");
+    const auto c = test::run_tracer(base + " --spp 4 --threads 2 --sched async -o " + dir + "/c.ppm");
+    const auto one = test::run_tracer(base + " --spp 1 -o " + dir + "/one.ppm");
+    const auto centre = test::run_tracer(base + " -o " + dir + "/centre.ppm");
+    for (const auto* r : {&a, &b, &c, &one, &centre}) ASSERT_EQ(r->exit_code, 0) << r->output;
+    EXPECT_EQ(read_bytes(dir + "/a.ppm"), read_bytes(dir + "/b.ppm"));
+    EXPECT_EQ(read_bytes(dir + "/a.ppm"), read_bytes(dir + "/c.ppm"));
+    EXPECT_EQ(read_bytes(dir + "/one.ppm"), read_bytes(dir + "/centre.ppm"));  // one sample: the pixel centre
+    EXPECT_NE(read_bytes(dir + "/a.ppm"), read_bytes(dir + "/one.ppm"));       // four: edges are smoothed
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tracer

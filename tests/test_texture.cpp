@@ -10,6 +10,7 @@
 
 #include "accel/accelerator.hpp"
 #include "io/exr_io.hpp"
+#include "parallel/executor.hpp"
 #include "render/render_image.hpp"
 #include "scene/obj_loader.hpp"
 #include "scene/texture.hpp"
@@ -192,6 +193,32 @@ TEST(Texture, TheSharedScenesFindAllTheirDiffuseTextures) {
     }
     EXPECT_GT(scene.textures.size(), 0u) << path;
     EXPECT_FALSE(scene.corner_uvs.empty()) << path;
+  }
+}
+
+TEST(ParallelTextures, TheSameSceneAsOneThread) {
+  if (!test::have_shared_scenes()) GTEST_SKIP() << "needs ../shared/scenes";
+  const std::string path = test::scene_path("sponza/sponza.obj");
+  const Executor executor(Strategy::Tbb, 2);
+  for (const uint64_t budget : {uint64_t(2048) << 20, uint64_t(2) << 20}) {
+    LoadLimits one, many;
+    one.textures.max_total_bytes = many.textures.max_total_bytes = budget;
+    many.for_each = [&](size_t count, const std::function<void(size_t)>& body) { executor.for_each(count, body); };
+    std::vector<std::string> w1, w2;
+    const Scene a = load_obj(
+        path, [&](const std::string& w) { w1.push_back(w); }, nullptr, one);
+    const Scene b = load_obj(
+        path, [&](const std::string& w) { w2.push_back(w); }, nullptr, many);
+    EXPECT_EQ(w1, w2);
+    ASSERT_EQ(a.textures.size(), b.textures.size());
+    for (size_t t = 0; t < a.textures.size(); ++t) EXPECT_EQ(a.textures[t].srgb(), b.textures[t].srgb()) << t;
+    ASSERT_EQ(a.materials.size(), b.materials.size());
+    for (size_t m = 0; m < a.materials.size(); ++m) {
+      EXPECT_EQ(a.materials[m].diffuse_texture, b.materials[m].diffuse_texture) << m;
+    }
+    if (budget < (uint64_t(100) << 20)) {
+      EXPECT_FALSE(w1.empty());  // some textures left out, and said
+    }
   }
 }
 
