@@ -143,7 +143,7 @@ class Bvh {
 // the ray touches, folded into a second reciprocal, which rounds once as the separate multiply
 // did; boxes are kept up to kTieGuard beyond tfar so ties resolve as in brute force. That guard is
 // relative: a triangle t whose rounding is larger (t small beside its vertices' distances, hit near
-// an edge) can still fall below its box's entry; the README states what then differs.
+// an edge) can still fall below its box's entry; docs/RENDERING.md states what then differs.
 struct RayBoxTest : SlabGuards {
   float org[3], inv[3], inv_far[3];
   // Byte offsets, within a BvhNode, of the plane each slab enters and leaves by: the ray's

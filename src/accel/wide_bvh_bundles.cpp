@@ -1,5 +1,5 @@
 // The 8-wide BVH's AO bundles: up to 16 rays leaving one point searched top-down together while
-// many of them enter the same nodes (README, "--packets"), compiled once per SIMD target.
+// many of them enter the same nodes (docs/RENDERING.md, "Packets"), compiled once per SIMD target.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "accel/wide_bvh_bundles.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
