@@ -78,7 +78,8 @@ InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_
   if (::fstat(fd, &st) != 0) throw InputError(name + ": cannot open: " + reason(errno));
   if (S_ISDIR(st.st_mode)) throw InputError(name + ": cannot open: is a directory");
   const auto too_large = [&] {
-    return InputTooLarge(name + ": larger than " + mib(max_bytes) + ", the limit for this input (docs/RELIABILITY.md: Limits)");
+    return InputTooLarge(name + ": larger than " + mib(max_bytes) +
+                         ", the limit for this input (docs/RELIABILITY.md: Limits)");
   };
   if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes) throw too_large();
   if (remember) remember_input(st, name);
