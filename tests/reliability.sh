@@ -139,17 +139,28 @@ stall_rank() {
   wait "$job"
 }
 export -f stall_rank
+# start_viewer: `tracer view ok.obj` on a free port in the background; sets viewer (its pid),
+# port and token. stop_viewer ends it.
+start_viewer() {
+  viewer_out=$(mktemp)
+  "$TRACER_BIN" view ok.obj --port 0 -q > "$viewer_out" 2>/dev/null &
+  viewer=$!
+  for _ in $(seq 200); do grep -q 'token=' "$viewer_out" && break; sleep 0.05; done
+  port=$(sed -E 's|.*:([0-9]+)/.*|\1|' "$viewer_out")
+  token=$(sed -E 's|.*token=([0-9a-f]+).*|\1|' "$viewer_out")
+}
+stop_viewer() {
+  kill -INT "$viewer"
+  wait "$viewer" 2>/dev/null
+  rm -f "$viewer_out"
+}
+export -f start_viewer stop_viewer
 # view_request REQUEST: starts `tracer view ok.obj` on a free port, sends REQUEST (PORT and TOKEN
 # replaced by the viewer's) over a raw connection, and writes the answer's status line and its
 # error message to stderr (the table's column); the viewer is then stopped.
 view_request() {
-  local out port token
-  out=$(mktemp)
-  "$TRACER_BIN" view ok.obj --port 0 -q > "$out" 2>/dev/null &
-  local viewer=$!
-  for _ in $(seq 200); do grep -q 'token=' "$out" && break; sleep 0.05; done
-  port=$(sed -E 's|.*:([0-9]+)/.*|\1|' "$out")
-  token=$(sed -E 's|.*token=([0-9a-f]+).*|\1|' "$out")
+  local viewer viewer_out port token
+  start_viewer
   local request=${1//PORT/$port}
   request=${request//TOKEN/$token}
   exec 3<>"/dev/tcp/127.0.0.1/$port"
@@ -157,22 +168,15 @@ view_request() {
   local answer
   answer=$(timeout 5 cat <&3 | tr -d '\r')
   exec 3<&-
-  kill -INT "$viewer"
-  wait "$viewer" 2>/dev/null
-  rm -f "$out"
+  stop_viewer
   echo "$(head -n 1 <<< "$answer"): $(tail -n 1 <<< "$answer")" >&2
 }
 export -f view_request
 # slow_clients: fifty connections to `tracer view` trickling a header line a second (no token),
 # then a real request; its status line goes to stderr.
 slow_clients() {
-  local out port token
-  out=$(mktemp)
-  "$TRACER_BIN" view ok.obj --port 0 -q > "$out" 2>/dev/null &
-  local viewer=$!
-  for _ in $(seq 200); do grep -q 'token=' "$out" && break; sleep 0.05; done
-  port=$(sed -E 's|.*:([0-9]+)/.*|\1|' "$out")
-  token=$(sed -E 's|.*token=([0-9a-f]+).*|\1|' "$out")
+  local viewer viewer_out port token
+  start_viewer
   local slow=()
   for _ in $(seq 50); do
     (exec 3<>"/dev/tcp/127.0.0.1/$port" && printf 'GET /state HTTP/1.1\r\n' >&3 &&
@@ -186,9 +190,7 @@ slow_clients() {
   answer=$(timeout 5 head -n 1 <&3 | tr -d '\r')
   exec 3<&-
   kill "${slow[@]}" 2>/dev/null
-  kill -INT "$viewer"
-  wait "$viewer" 2>/dev/null
-  rm -f "$out"
+  stop_viewer
   echo "${answer:-no answer within 5 s}" >&2
 }
 export -f slow_clients
