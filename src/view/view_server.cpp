@@ -100,11 +100,10 @@ class ConnectionStream : public httplib::Stream {
   int sock_;
 };
 
-// The head of the next request, peeked (left in the socket for cpp-httplib to read): empty if
-// the client sent nothing before `first_byte` or closed, or its head did not end within
-// kHeadDeadline of its first byte (or kMaxHeadBytes).
-std::string peek_head(const ConnectionStream& stream, Clock::time_point first_byte, bool& complete) {
-  complete = false;
+// The head of the next request, peeked (left in the socket for cpp-httplib to read), ending in
+// its blank line; empty if the client sent nothing before `first_byte` or closed, or its head did
+// not end within kHeadDeadline of its first byte (or kMaxHeadBytes).
+std::string peek_head(const ConnectionStream& stream, Clock::time_point first_byte) {
   if (!stream.wait(POLLIN, ms_until(first_byte))) return {};
   const auto deadline = Clock::now() + kHeadDeadline;
   std::string buffer(kMaxHeadBytes, '\0');
@@ -113,7 +112,6 @@ std::string peek_head(const ConnectionStream& stream, Clock::time_point first_by
     if (n <= 0) return {};
     const std::string_view seen(buffer.data(), size_t(n));
     if (const size_t end = seen.find("\r\n\r\n"); end != std::string_view::npos) {
-      complete = true;
       return std::string(seen.substr(0, end + 4));
     }
     if (size_t(n) == buffer.size()) return {};
@@ -157,10 +155,9 @@ class GuardedServer : public httplib::Server {
           Clock::now() +
           std::chrono::seconds(count == keep_alive_max_count_ ? read_timeout_sec_ : keep_alive_timeout_sec_);
       pending_.add(client, sock);
-      bool complete = false;
-      const std::string head = peek_head(stream, first_byte, complete);
+      const std::string head = peek_head(stream, first_byte);
       pending_.remove(client, sock);
-      if (!complete) break;
+      if (head.empty()) break;
       if (const HeadCheck check = check_head(head, token_, port_, any_host_); check.status != 0) {
         answer(stream, check.status, check.message);
         // What the client still sends is read briefly and dropped, so it sees the answer rather
