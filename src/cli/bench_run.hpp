@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli/bench_catalogue.hpp"
-#include "render/settings.hpp"
+#include "render/render_settings.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer::cli {

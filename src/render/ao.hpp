@@ -11,8 +11,7 @@
 
 #include "math/rng.hpp"
 #include "parallel/tiles.hpp"
-#include "render/accel_concepts.hpp"
-#include "render/surface_point.hpp"
+#include "render/direct_light.hpp"
 
 namespace tracer {
 
@@ -26,34 +25,10 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
   return dot(d, n) < 0.0f ? -d : d;
 }
 
-// The shadow ray from `sp` toward `light` and what the light adds if nothing blocks it; false
-// when the light cannot contribute (it is the surface's own emitter, or behind the surface).
-inline bool light_sample(const SurfacePoint& sp, const Light& light, Ray& shadow, Vec3& contribution) {
-  if (light.geomID == sp.geomID) return false;  // an emitter does not light itself
-  const Vec3 to_light = light.position - sp.origin;
-  const float d2 = dot(to_light, to_light);
-  if (!(d2 > 0.0f)) return false;
-  const float d = std::sqrt(d2);
-  const Vec3 wi = to_light / d;
-  if (dot(sp.n, wi) <= 0.0f) return false;  // below the surface itself, whatever the shading normal
-  const float cos_surface = dot(sp.shading_n, wi);
-  if (cos_surface <= 0.0f) return false;
-  // Irradiance from a light of area A at distance d: power * cos_l / (d^2 + A/pi), exact on the
-  // axis of a disk of that area and free of the 1/d^2 blow-up near the lamp; 1/d^2 for points.
-  const float cos_light = light.is_point() ? 1.0f : std::fabs(dot(light.normal, wi));
-  const float falloff = cos_light / (d2 + light.area * std::numbers::inv_pi_v<float>);
-  shadow = Ray{};
-  shadow.org = sp.origin;
-  shadow.dir = wi;
-  shadow.tfar = d * (1.0f - 1e-4f);  // stop short of the light's own surface
-  contribution = sp.albedo_over_pi * light.power * (falloff * cos_surface);
-  return true;
-}
-
-// Adds the ambient term, scaled by the fraction of `sp`'s AO rays that escape, and returns the
+// Adds the ambient term, scaled by the fraction of `si`'s AO rays that escape, and returns the
 // pixel's colour.
 template <class Accel>
-Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfacePoint& sp,
+Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfaceInteraction& si,
                          RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
   float unoccluded = 1.0f;
@@ -64,7 +39,7 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
     const uint32_t first_ray = sample * uint32_t(s.ao_samples);
     const auto direction = [&](int i) {
       const SampleRng rng(pixel, first_ray + uint32_t(i), s.seed);
-      return ao_direction(sp.n, rng.draw(0), rng.draw(1));
+      return ao_direction(si.n, rng.draw(0), rng.draw(1));
     };
     int open = 0;
     bool bundled = false;
@@ -73,11 +48,11 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
         // Up to 16 rays at a time; each gets the answer it gets alone, so the image is the same.
         for (int first = 0; first < s.ao_samples; first += kPacketSize) {
           RayBundle bundle;
-          bundle.org = sp.origin;
+          bundle.org = si.origin;
           bundle.tfar = s.ao_distance;
           const int count = std::min(kPacketSize, s.ao_samples - first);
           for (int k = 0; k < count; ++k) bundle.set_direction(k, direction(first + k));
-          open += count - std::popcount(accel.occluded_bundle_from(bundle, sp.tri));
+          open += count - std::popcount(accel.occluded_bundle_from(bundle, si.tri));
         }
         bundled = true;
       }
@@ -85,28 +60,16 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
     if (!bundled) {
       for (int i = 0; i < s.ao_samples; ++i) {
         Ray ao;
-        ao.org = sp.origin;
+        ao.org = si.origin;
         ao.dir = direction(i);
         ao.tfar = s.ao_distance;
-        open += occluded_leaving(accel, ao, sp.tri) ? 0 : 1;
+        open += occluded_leaving(accel, ao, si.tri) ? 0 : 1;
       }
     }
     counts.ao += uint64_t(s.ao_samples);
     unoccluded = float(open) / float(s.ao_samples);
   }
-  return sp.color + sp.mat->kd * (s.ambient * unoccluded);
-}
-
-// Adds to sp.color what every light gives it, one shadow ray per light, in the lights' order.
-template <class Accel>
-void add_direct_light(const Accel& accel, const RenderContext& ctx, SurfacePoint& sp, RayCounts& counts) {
-  for (const Light& light : ctx.scene->lights) {
-    Ray shadow;
-    Vec3 contribution;
-    if (!light_sample(sp, light, shadow, contribution)) continue;
-    ++counts.shadow;
-    if (!occluded_leaving(accel, shadow, sp.tri)) sp.color += contribution;
-  }
+  return si.color + si.mat->kd * (s.ambient * unoccluded);
 }
 
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
@@ -114,9 +77,9 @@ template <class Accel>
 Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
                RayCounts& counts, uint32_t sample = 0) {
   if (!hit.valid()) return Vec3{0.0f};
-  SurfacePoint sp = surface_point(ctx, primary, hit);
-  add_direct_light(accel, ctx, sp, counts);
-  return finish_with_ambient(accel, ctx, x, y, sp, counts, sample);
+  SurfaceInteraction si = surface_interaction(ctx, primary, hit);
+  add_lamp_light(accel, ctx, si, counts);
+  return finish_with_ambient(accel, ctx, x, y, si, counts, sample);
 }
 
 template <class Accel>
@@ -145,7 +108,7 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
   Hit hits[kPacketSize];
   accel.intersect_packet(packet, hits);
   counts.primary += uint64_t(std::popcount(packet.active));
-  SurfacePoint sps[kPacketSize];
+  SurfaceInteraction sis[kPacketSize];
   uint32_t lit = 0;  // lanes that hit something
   for (uint32_t bits = packet.active; bits; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
@@ -153,7 +116,7 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
       ctx.framebuffer->add(bx + k % kPacketEdge, by + k / kPacketEdge, Vec3{0.0f});
       continue;
     }
-    sps[k] = surface_point(ctx, rays[k], hits[k]);
+    sis[k] = surface_interaction(ctx, rays[k], hits[k]);
     lit |= 1u << k;
   }
   for (const Light& light : ctx.scene->lights) {
@@ -161,8 +124,11 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
     Vec3 contribution[kPacketSize];
     for (uint32_t bits = lit; bits; bits &= bits - 1) {
       const int k = __builtin_ctz(bits);
-      Ray shadow;
-      if (light_sample(sps[k], light, shadow, contribution[k])) shadows.set(k, shadow);
+      LightSample ls;
+      float cos_surface;
+      if (!lamp_sample_at(light, sis[k], ls, cos_surface)) continue;
+      shadows.set(k, shadow_ray(sis[k], ls));
+      contribution[k] = light_contribution(ls, sis[k].albedo_over_pi, cos_surface);
     }
     if (shadows.active == 0) continue;
     counts.shadow += uint64_t(std::popcount(shadows.active));
@@ -172,18 +138,18 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
     } else {
       for (uint32_t bits = shadows.active; bits; bits &= bits - 1) {
         const int k = __builtin_ctz(bits);
-        if (occluded_leaving(accel, shadows.ray(k), sps[k].tri)) blocked |= 1u << k;
+        if (occluded_leaving(accel, shadows.ray(k), sis[k].tri)) blocked |= 1u << k;
       }
     }
     for (uint32_t bits = shadows.active & ~blocked; bits; bits &= bits - 1) {
       const int k = __builtin_ctz(bits);
-      sps[k].color += contribution[k];
+      sis[k].color += contribution[k];
     }
   }
   for (uint32_t bits = lit; bits; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
     const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-    ctx.framebuffer->add(x, y, finish_with_ambient(accel, ctx, x, y, sps[k], counts));
+    ctx.framebuffer->add(x, y, finish_with_ambient(accel, ctx, x, y, sis[k], counts));
   }
 }
 

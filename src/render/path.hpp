@@ -13,9 +13,8 @@
 
 #include "math/sobol.hpp"
 #include "parallel/tiles.hpp"
-#include "render/accel_concepts.hpp"
-#include "render/environment_light.hpp"
-#include "render/surface_point.hpp"
+#include "render/direct_light.hpp"
+#include "render/texture_lookup.hpp"
 #include "shade/material_bsdf.hpp"
 
 namespace tracer {
@@ -60,16 +59,37 @@ inline bool sample_bsdf(const Bsdf& bsdf, Vec3 wo, const PixelSampler& sampler, 
   return bsdf.sample(wo, u[2], u[0], u[1], out);
 }
 
+// Next-event estimation at a non-specular vertex `si` seen from `wo`, as pbrt-v4's SampleLd: with
+// multiple importance sampling on (`mis`), one sample of the environment or an emitter by the
+// light numbers `u`, weighted against the BSDF sampling the same direction; then every point lamp,
+// which only this finds. Each unblocked sample adds beta * f * L / pdf (times its weight) to
+// `radiance`, in that order.
+template <class Accel>
+void add_sampled_light(const Accel& accel, const LightSampler& lights, const SurfaceInteraction& si, const Bsdf& bsdf,
+                       Vec3 wo, std::array<float, 3> u, bool mis, Vec3 beta, Vec3& radiance, RayCounts& counts) {
+  LightSample ls;
+  if (mis && lights.sample(si, u, ls) && dot(ls.wi, si.n) > 0.0f) {
+    const Vec3 f = bsdf.eval(wo, ls.wi);
+    if (max_component(f * ls.L) > 0.0f) {
+      const float w = power_heuristic(ls.pdf, bsdf.pdf(wo, ls.wi));
+      radiance += direct_light(accel, si, ls, beta * f, w, counts);
+    }
+  }
+  for (const Light& lamp : lights.lamps()) {
+    if (!lamp.is_point() || !sample_lamp(lamp, si, ls)) continue;
+    const Vec3 f = bsdf.eval(wo, ls.wi);
+    if (!(max_component(f) > 0.0f)) continue;
+    radiance += direct_light(accel, si, ls, beta * f, 1.0f, counts);
+  }
+}
+
 template <class Accel>
 Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PixelSampler& sampler,
                    RayCounts& counts, FirstHit* first = nullptr) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
-  const EnvironmentLight env = EnvironmentLight::of(ctx);
+  const LightSampler lights(ctx);
   const bool nee = s.light_sampling == LightSampling::Mis;
-  // A light sample picks the environment with this probability, else an emitter.
-  const float p_env = env.black() ? 0.0f : scene.emitters.empty() ? 1.0f : 0.5f;
-  const bool choose_light = (p_env > 0.0f && p_env < 1.0f) || scene.emitters.size() > 1;
   Vec3 radiance{0.0f}, beta{1.0f};
   // No light sample could have found what this ray finds: the last bounce was a delta lobe (or
   // this is the camera ray), or it went through the surface, where light samples never go.
@@ -80,104 +100,55 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!accel.intersect(ray, hit)) {
-      if (p_env > 0.0f) {
+      if (lights.lights_environment()) {
         float w = 1.0f;
-        if (nee && !unsampled) w = power_heuristic(bsdf_pdf, p_env * env.pdf(prev_n, ray.dir));
-        radiance += beta * env.radiance(ray.dir) * w;
+        if (nee && !unsampled) w = power_heuristic(bsdf_pdf, lights.pdf_environment(prev_n, ray.dir));
+        radiance += beta * lights.environment().radiance(ray.dir) * w;
       }
       break;
     }
-    SurfacePoint sp = surface_point(ctx, ray, hit);
-    sp.shading_n = interpolated_normal(scene, hit, sp.n);
-    const Material& mat = *sp.mat;
-    sp.shading_n = bumped_normal(scene, hit, mat, sp.shading_n, -ray.dir);
-    if (mat.emissive() && sp.front) {  // emitters shine from their front face (see Emitters)
+    SurfaceInteraction si = surface_interaction(ctx, ray, hit);
+    si.shading_n = interpolated_normal(scene, hit, si.n);
+    const Material& mat = *si.mat;
+    si.shading_n = bumped_normal(scene, hit, mat, si.shading_n, -ray.dir);
+    if (mat.emissive() && si.front) {  // emitters shine from their front face (see Emitters)
       float w = 1.0f;
       if (nee && !unsampled) {
-        w = power_heuristic(bsdf_pdf, (1.0f - p_env) * scene.emitters.pdf(scene, hit.tri, ray.org, sp.position));
+        w = power_heuristic(bsdf_pdf, lights.pdf_emitter(hit.tri, ray.org, si.position));
       }
       radiance += beta * mat.ke * w;
     }
     if (depth >= s.max_depth) break;
-    const Vec3 kd = diffuse_color(scene, hit, mat, cone, std::fabs(dot(ray.dir, sp.n)));
-    const Bsdf bsdf = material_bsdf(mat, kd, sp.shading_n, sp.front);
+    const Vec3 kd = diffuse_color(scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
+    const Bsdf bsdf = material_bsdf(mat, kd, si.shading_n, si.front);
     const Vec3 wo = -ray.dir;
     if (depth == 0 && first) {
       const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
       first->albedo = Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
-      first->normal = sp.shading_n;
+      first->normal = si.shading_n;
     }
     if (!bsdf.delta()) {
-      const std::array<float, 3> lu =
-          choose_light ? sampler.get<3>(light_set(depth)) : with_third(sampler.get<2>(light_set(depth)));
-      // One light sample: L * f * cos / pdf, weighted against BSDF sampling.
-      Vec3 wi, emitted{0.0f};
-      float light_pdf = 0.0f, distance = kInfinity;
-      if (nee && lu[2] < p_env) {
-        if (env.sample(sp.n, lu[0], lu[1], wi, light_pdf)) {
-          light_pdf *= p_env;
-          emitted = env.radiance(wi);
-        }
-      } else if (nee) {
-        EmitterSample es;
-        const float u_select = (lu[2] - p_env) / (1.0f - p_env);
-        if (scene.emitters.sample(scene, sp.origin, std::min(u_select, 0x1.fffffep-1f), lu[0], lu[1], es)) {
-          wi = es.wi;
-          light_pdf = es.pdf * (1.0f - p_env);
-          emitted = es.radiance;
-          distance = es.distance * (1.0f - 1e-4f);  // stop short of the emitter's own surface
-        }
-      }
-      if (light_pdf > 0.0f && dot(wi, sp.n) > 0.0f) {
-        const Vec3 f = bsdf.eval(wo, wi);
-        if (max_component(f * emitted) > 0.0f) {
-          Ray shadow;
-          shadow.org = sp.origin;
-          shadow.dir = wi;
-          shadow.tfar = distance;
-          ++counts.shadow;
-          if (!occluded_leaving(accel, shadow, sp.tri)) {
-            const float w = power_heuristic(light_pdf, bsdf.pdf(wo, wi));
-            radiance += beta * f * emitted * (w / light_pdf);
-          }
-        }
-      }
-      // Point lights (--light, a view's light): delta lights, found only this way.
-      for (const Light& light : scene.lights) {
-        if (!light.is_point()) continue;
-        const Vec3 to = light.position - sp.origin;
-        const float d2 = dot(to, to);
-        if (!(d2 > 0.0f)) continue;
-        const float d = std::sqrt(d2);
-        const Vec3 to_light = to / d;
-        if (dot(to_light, sp.n) <= 0.0f) continue;
-        const Vec3 f = bsdf.eval(wo, to_light);
-        if (!(max_component(f) > 0.0f)) continue;
-        Ray shadow;
-        shadow.org = sp.origin;
-        shadow.dir = to_light;
-        shadow.tfar = d;
-        ++counts.shadow;
-        if (!occluded_leaving(accel, shadow, sp.tri)) radiance += beta * f * light.power / d2;
-      }
+      const std::array<float, 3> u =
+          lights.chooses() ? sampler.get<3>(light_set(depth)) : with_third(sampler.get<2>(light_set(depth)));
+      add_sampled_light(accel, lights, si, bsdf, wo, u, nee, beta, radiance, counts);
     }
     BsdfSample bs;
     if (!sample_bsdf(bsdf, wo, sampler, bsdf_set(depth), bs)) break;
     // The shading normal may send a reflection through the geometric surface (or a refraction
     // back out): such a sample has no consistent meaning, so the path ends.
-    if ((dot(bs.wi, sp.n) < 0.0f) != bs.transmitted) break;
+    if ((dot(bs.wi, si.n) < 0.0f) != bs.transmitted) break;
     beta = beta * bs.weight;
     cone = bs.delta ? RayCone{cone.width_at(hit.t), cone.spread} : RayCone{};
     unsampled = bs.delta || bs.transmitted;
     bsdf_pdf = bs.pdf;
-    prev_n = sp.n;
+    prev_n = si.n;
     if (depth >= kRouletteDepth) {
       const float keep = std::min(0.95f, max_component(beta));
       if (!(sampler.get<1>(roulette_set(depth))[0] < keep)) break;
       beta = beta / keep;
     }
     ray = Ray{};
-    ray.org = offset_origin(sp.position, bs.transmitted ? -sp.n : sp.n);
+    ray.org = offset_origin(si.position, bs.transmitted ? -si.n : si.n);
     ray.dir = bs.wi;
     ++counts.secondary;
   }

@@ -1,15 +1,11 @@
-// What a render is asked to do (RenderSettings), what it counts (RayCounts) and what every tile
-// shares (RenderContext).
+// What a render is asked to do: the integrator, its light sampling, and the numbers that shape
+// the image (RenderSettings).
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 
 #include "base/enum_names.hpp"
-#include "film/framebuffer.hpp"
 #include "math/ray.hpp"
-#include "scene/camera.hpp"
-#include "scene/scene.hpp"
 
 namespace tracer {
 
@@ -43,48 +39,6 @@ struct RenderSettings {
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
-};
-
-struct RayCounts {
-  uint64_t primary = 0, shadow = 0, ao = 0, secondary = 0;  // secondary: reflected and refracted rays
-  uint64_t total() const { return primary + shadow + ao + secondary; }
-  RayCounts& operator+=(const RayCounts& o) {
-    primary += o.primary;
-    shadow += o.shadow;
-    ao += o.ao;
-    secondary += o.secondary;
-    return *this;
-  }
-};
-
-// Thread-safe accumulation of per-tile counts (one atomic add per tile, never per ray).
-struct AtomicRayCounts {
-  std::atomic<uint64_t> primary{0}, shadow{0}, ao{0}, secondary{0};
-  void add(const RayCounts& c) {
-    primary.fetch_add(c.primary, std::memory_order_relaxed);
-    shadow.fetch_add(c.shadow, std::memory_order_relaxed);
-    ao.fetch_add(c.ao, std::memory_order_relaxed);
-    secondary.fetch_add(c.secondary, std::memory_order_relaxed);
-  }
-  RayCounts load() const { return {primary.load(), shadow.load(), ao.load(), secondary.load()}; }
-};
-
-// The samples of each pixel one pass adds: [first, first + count).
-struct SampleRange {
-  uint32_t first = 0, count = 1;
-};
-
-// Everything one tile needs; shared read-only by all workers except the disjoint framebuffer pixels.
-struct RenderContext {
-  const Scene* scene = nullptr;
-  Camera camera;
-  RenderSettings settings;
-  Framebuffer* framebuffer = nullptr;
-  SampleRange samples;  // path: this pass's samples (ao and whitted take one, at the pixel centre)
-  // path, --aov: where each sample's first hit adds its albedo and shading normal (for a
-  // denoiser), summed and counted as the radiance is; null when not asked for.
-  Framebuffer* albedo = nullptr;
-  Framebuffer* normal = nullptr;
 };
 
 }  // namespace tracer

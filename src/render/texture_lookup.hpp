@@ -1,63 +1,14 @@
-// A hit being shaded: where it is, which side was hit, the normals shading uses, and where the
-// rays it sends start.
+// What the textures say at a hit: the diffuse colour filtered to the ray's footprint (ray cones
+// and the texture level of detail) and the shading normal moved by the bump map.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "math/ray.hpp"
-#include "render/settings.hpp"
+#include "scene/scene.hpp"
 
 namespace tracer {
-
-// Moves a surface point off its surface along the geometric normal (on the side the new ray
-// leaves from), by a margin that grows with the coordinates' magnitude like float rounding does.
-inline Vec3 offset_origin(Vec3 p, Vec3 n) {
-  const float eps = 1e-4f * (1.0f + max_component(abs(p)));
-  return p + n * eps;
-}
-
-// A primary hit being shaded: the normal on the side the camera sees, the origin of the rays it
-// sends, and the colour so far.
-struct SurfacePoint {
-  Vec3 position, n, origin, albedo_over_pi, color;  // origin: position moved off the surface along n
-  Vec3 shading_n;  // the normal shading uses: n, or the interpolated vertex normal on n's side
-  bool front;      // the ray hit the side the triangle's winding faces
-  const Material* mat;
-  uint32_t tri, geomID;
-};
-
-inline SurfacePoint surface_point(const RenderContext& ctx, const Ray& primary, const Hit& hit) {
-  const Scene& scene = *ctx.scene;
-  const Triangle& tri = scene.triangles[hit.tri];
-  SurfacePoint sp;
-  sp.mat = &scene.materials[scene.tri_material[hit.tri]];
-  sp.n = normalize(tri.normal());
-  sp.front = dot(sp.n, primary.dir) <= 0.0f;
-  if (!sp.front) sp.n = -sp.n;  // shade the side the camera sees
-  // Barycentric position: more precise than org + t*dir far from the camera.
-  const Vec3 p = tri.v0 * (1.0f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v;
-  sp.position = p;
-  sp.shading_n = sp.n;
-  sp.origin = offset_origin(p, sp.n);
-  sp.albedo_over_pi = sp.mat->kd * std::numbers::inv_pi_v<float>;
-  sp.color = sp.mat->ke;
-  sp.tri = hit.tri;
-  sp.geomID = hit.geomID;
-  return sp;
-}
-
-// The vertex normals of the hit triangle interpolated at the hit, turned to the side of the
-// geometric normal `n` (which faces the ray); `n` itself where the scene has none.
-inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
-  if (scene.corner_normals.empty()) return n;
-  const Vec3* c = &scene.corner_normals[3 * size_t(hit.tri)];
-  const Vec3 s = c[0] * (1.0f - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
-  const float len = length(s);
-  if (!(len > 0.0f) || !std::isfinite(len)) return n;
-  const Vec3 unit = s / len;
-  return dot(unit, n) < 0.0f ? -unit : unit;
-}
 
 // The texture coordinates at a hit, interpolated from its triangle's corners `c`.
 inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {

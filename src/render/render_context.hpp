@@ -1,0 +1,33 @@
+// What every tile of a render shares (RenderContext): the scene, the camera, the settings, the
+// films it adds to, and the samples this pass takes.
+#pragma once
+
+#include <cstdint>
+
+#include "film/framebuffer.hpp"
+#include "render/ray_counts.hpp"
+#include "render/render_settings.hpp"
+#include "scene/camera.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+// The samples of each pixel one pass adds: [first, first + count).
+struct SampleRange {
+  uint32_t first = 0, count = 1;
+};
+
+// Everything one tile needs; shared read-only by all workers except the disjoint framebuffer pixels.
+struct RenderContext {
+  const Scene* scene = nullptr;
+  Camera camera;
+  RenderSettings settings;
+  Framebuffer* framebuffer = nullptr;
+  SampleRange samples;  // path: this pass's samples (ao and whitted take one, at the pixel centre)
+  // path, --aov: where each sample's first hit adds its albedo and shading normal (for a
+  // denoiser), summed and counted as the radiance is; null when not asked for.
+  Framebuffer* albedo = nullptr;
+  Framebuffer* normal = nullptr;
+};
+
+}  // namespace tracer
