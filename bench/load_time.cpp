@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "importers/obj_loader.hpp"
 #include "parallel/executor.hpp"
-#include "scene/obj_loader.hpp"
 
 namespace {
 

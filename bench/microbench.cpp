@@ -13,12 +13,12 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "importers/obj_loader.hpp"
 #include "math/sampling.hpp"
 #include "render/ao.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/views.hpp"
 
 namespace tracer {

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "base/errors.hpp"
+#include "importers/obj_loader.hpp"
 #include "oracle/mtl_oracle.hpp"
-#include "scene/obj_loader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string mtl(reinterpret_cast<const char*>(data), size);

@@ -9,7 +9,7 @@
 
 #include "accel/bvh.hpp"
 #include "base/errors.hpp"
-#include "scene/obj_loader.hpp"
+#include "importers/obj_loader.hpp"
 #include "scene/scene_checksum.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -14,7 +14,7 @@
 #include "accel/accelerator.hpp"
 #include "accel/triangle_test.hpp"
 #include "base/errors.hpp"
-#include "scene/obj_loader.hpp"
+#include "importers/obj_loader.hpp"
 
 namespace {
 

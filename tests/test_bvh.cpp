@@ -12,9 +12,9 @@
 #include "accel/embree_accel.hpp"
 #include "base/huge_pages.hpp"
 #endif
+#include "importers/obj_loader.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
-#include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

@@ -16,8 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include "base/errors.hpp"
+#include "importers/obj_loader.hpp"
 #include "parallel/executor.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/texture.hpp"
 #include "test_util.hpp"
 

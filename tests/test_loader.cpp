@@ -11,8 +11,8 @@
 #include <fstream>
 
 #include "base/errors.hpp"
+#include "importers/obj_loader.hpp"
 #include "scene/builtin.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/scene_checksum.hpp"
 #include "test_util.hpp"
 

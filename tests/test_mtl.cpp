@@ -1,4 +1,4 @@
-// The MTL reader (scene/mtl_parser.hpp): the format's statements, the errors that keep a wrong
+// The MTL reader (importers/mtl_parser.hpp): the format's statements, the errors that keep a wrong
 // image from being made, the oddities of real exporters as one grouped warning, and tinyobjloader
 // as the oracle on the files in the repository and on generated ones.
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 #include <string>
 
 #include "base/errors.hpp"
+#include "importers/mtl_parser.hpp"
+#include "importers/obj_loader.hpp"
 #include "oracle/mtl_oracle.hpp"
-#include "scene/mtl_parser.hpp"
-#include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

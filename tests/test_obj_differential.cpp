@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "base/errors.hpp"
-#include "scene/obj_loader.hpp"
+#include "importers/obj_loader.hpp"
 
 namespace tracer {
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "importers/obj_loader.hpp"
 #include "render/render_image.hpp"
 #include "scene/builtin.hpp"
-#include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

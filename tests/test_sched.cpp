@@ -6,10 +6,10 @@
 #include <mutex>
 
 #include "accel/accelerator.hpp"
+#include "importers/obj_loader.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
-#include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

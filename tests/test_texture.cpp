@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "importers/obj_loader.hpp"
 #include "io/exr_io.hpp"
 #include "parallel/executor.hpp"
 #include "render/render_image.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/texture.hpp"
 #include "test_util.hpp"
 

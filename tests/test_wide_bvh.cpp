@@ -12,9 +12,9 @@
 #include "render/render_tile.hpp"
 
 #include "accel/accelerator.hpp"
+#include "importers/obj_loader.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/obj_loader.hpp"
 #include "test_util.hpp"
 
 namespace tracer {

@@ -14,11 +14,11 @@
 #include "cli/bench_run.hpp"
 #include "driver/parse.hpp"
 #include "driver/render_args.hpp"
+#include "importers/obj_loader.hpp"
 #include "io/image_io.hpp"
 #include "parallel/thread_count.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/obj_loader.hpp"
 
 namespace tracer::cli {
 

@@ -12,12 +12,12 @@
 
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
+#include "importers/obj_loader.hpp"
 #include "io/environment_io.hpp"
 #include "io/image_io.hpp"
 #include "parallel/executor.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/views.hpp"
 
 namespace tracer::driver {

@@ -8,10 +8,10 @@
 
 #include "accel/accelerator.hpp"
 #include "driver/render_driver.hpp"
+#include "importers/obj_loader.hpp"
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
-#include "scene/obj_loader.hpp"
 #include "scene/scene.hpp"
 
 namespace CLI {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "base/errors.hpp"
-#include "scene/mtl_parser.hpp"
+#include "importers/mtl_parser.hpp"
 
 namespace tracer::oracle {
 namespace {

@@ -1,4 +1,4 @@
-#include "scene/mtl_parser.hpp"
+#include "importers/mtl_parser.hpp"
 
 #include <charconv>
 #include <cmath>

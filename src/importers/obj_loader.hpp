@@ -1,4 +1,4 @@
-// OBJ/MTL loading: the bytes are read once and parsed in parallel chunks (scene/obj_parser.hpp),
+// OBJ/MTL loading: the bytes are read once and parsed in parallel chunks (importers/obj_parser.hpp),
 // the MTL files by the strict MTL parser, the textures read and decoded while the geometry is
 // parsed; every error names the file and line.
 #pragma once
@@ -8,7 +8,7 @@
 
 #include "base/errors.hpp"
 #include "base/read_input.hpp"
-#include "scene/obj_parser.hpp"
+#include "importers/obj_parser.hpp"
 #include "scene/scene.hpp"
 #include "scene/texture.hpp"
 

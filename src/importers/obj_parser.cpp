@@ -1,4 +1,4 @@
-#include "scene/obj_parser.hpp"
+#include "importers/obj_parser.hpp"
 
 #include <fast_float/fast_float.h>
 
@@ -12,6 +12,8 @@
 #include <utility>
 
 #include "base/text.hpp"
+#include "importers/obj_numbers.hpp"
+#include "math/triangulate.hpp"
 
 namespace tracer {
 
@@ -25,89 +27,6 @@ constexpr int64_t kMaxIndex = std::numeric_limits<int32_t>::max();
 // Chunks of at least this many bytes (smaller files are one chunk), and at most this many chunks.
 constexpr size_t kMinChunkBytes = size_t(1) << 18;
 constexpr size_t kMaxChunks = 64;
-// Polygons of more corners than this are fanned, not ear-clipped (ear clipping is cubic at worst).
-constexpr size_t kMaxEarClipCorners = 64;
-
-[[noreturn]] void fail_at(const std::string& name, uint64_t line, const std::string& what) {
-  throw InputError(name + ":" + std::to_string(line) + ": " + what);
-}
-
-// One number of a `v`, `vt` or `vn` line: a leading '+' is accepted, a value that underflows reads
-// as zero, and anything that is not a finite number within +-kMaxCoordinate is an error.
-float parse_coordinate(std::string_view tok, const std::string& name, uint64_t line) {
-  std::string_view digits = tok;
-  if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
-  double value = 0;
-  const auto r = fast_float::from_chars(digits.data(), digits.data() + digits.size(), value);
-  if (r.ec != std::errc{} || r.ptr != digits.data() + digits.size()) {
-    fail_at(name, line, "malformed number " + in_quotes(tok));
-  }
-  if (std::isfinite(value)) {
-    const float f = float(value);
-    if (std::fabs(f) <= kMaxCoordinate) return f;
-    fail_at(name, line,
-            "number out of range " + in_quotes(tok) + " (coordinates must lie within +-" + kMaxCoordinateText + ")");
-  }
-  // fast_float reads digits beyond double's range as infinity; "inf" and "nan" are words.
-  const char first = digits[digits.front() == '-' ? 1 : 0];
-  if ((first >= '0' && first <= '9') || first == '.') fail_at(name, line, "number out of range " + in_quotes(tok));
-  fail_at(name, line, "non-finite coordinate " + in_quotes(tok));
-}
-
-// One index of a corner written plainly: an optional '-' and at most 18 digits.
-bool parse_plain_index(const char*& p, const char* end, long long& out) {
-  const char* q = p;
-  const bool negative = q != end && *q == '-';
-  q += negative ? 1 : 0;
-  uint64_t v = 0;  // unsigned: a longer run of digits wraps (and is refused below), never overflows
-  const char* digits = q;
-  for (; q != end && static_cast<unsigned>(*q - '0') < 10; ++q) v = v * 10 + uint64_t(*q - '0');
-  if (q == digits || q - digits > 18) return false;
-  out = negative ? -static_cast<long long>(v) : static_cast<long long>(v);
-  p = q;
-  return true;
-}
-
-// One index of a face corner: an optional sign and decimal digits (a '+' is accepted).
-long long parse_index(std::string_view part, std::string_view tok, const std::string& name, uint64_t line) {
-  const char* p = part.data();
-  const char* const e = p + part.size();
-  if (e - p > 1 && *p == '+' && p[1] != '-' && p[1] != '+') ++p;
-  long long index = 0;
-  if (const char* q = p; parse_plain_index(q, e, index) && q == e) return index;
-  const auto [ptr, ec] = std::from_chars(p, e, index);
-  if (p == e || ec != std::errc{} || ptr != e) fail_at(name, line, "malformed face index " + in_quotes(tok));
-  return index;
-}
-
-bool is_blank(char c) { return c == ' ' || c == '\t'; }
-
-// The common number of an OBJ, "-12.3456": at most 15 significant digits and no exponent, so the
-// digits are exact in a double and one division by an exact power of ten rounds correctly (the
-// value fast_float gives). Anything else, and a value outside +-kMaxCoordinate, returns false
-// for the full parser to read (or to reject with its message).
-bool parse_plain_decimal(const char*& p, const char* end, float& out) {
-  static constexpr double kPow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                        1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
-  const char* q = p;
-  const bool negative = q != end && *q == '-';
-  q += negative ? 1 : 0;
-  uint64_t mantissa = 0;
-  int digits = 0, fraction = 0;
-  for (; q != end && static_cast<unsigned>(*q - '0') < 10; ++q, ++digits) mantissa = mantissa * 10 + uint64_t(*q - '0');
-  if (q != end && *q == '.') {
-    for (++q; q != end && static_cast<unsigned>(*q - '0') < 10; ++q, ++digits, ++fraction) {
-      mantissa = mantissa * 10 + uint64_t(*q - '0');
-    }
-  }
-  if (digits == 0 || digits > 15 || (q != end && !is_blank(*q))) return false;
-  const double value = double(mantissa) / kPow10[fraction];
-  const float f = float(negative ? -value : value);
-  if (std::fabs(f) > kMaxCoordinate) return false;
-  out = f;
-  p = q;
-  return true;
-}
 
 constexpr const char* kIndexKinds[3] = {"vertex", "texture coordinate", "normal"};
 
@@ -374,76 +293,6 @@ void ObjGeometry::Chunk::parse_line(std::string_view rest, const std::string& na
   }
   // Other statements (s, vp, curves, tags) do not make triangles and are skipped.
 }
-
-namespace {
-
-// The triangles of one face, as corner positions within it, in the face's winding. Quads split
-// along the shorter diagonal (as tinyobjloader does); larger polygons are ear-clipped in the plane
-// of their Newell normal, and fanned where that finds no ear (a self-intersecting outline) or the
-// polygon has more than kMaxEarClipCorners corners. Always corners - 2 triangles.
-void triangulate(const Vec3* p, uint32_t n, std::vector<std::array<uint32_t, 3>>& out) {
-  out.clear();
-  if (n == 3) {
-    out.push_back({0, 1, 2});
-    return;
-  }
-  if (n == 4) {
-    const Vec3 e02 = p[2] - p[0], e13 = p[3] - p[1];
-    const float sqr02 = e02.x * e02.x + e02.y * e02.y + e02.z * e02.z;
-    const float sqr13 = e13.x * e13.x + e13.y * e13.y + e13.z * e13.z;
-    if (sqr02 < sqr13) {
-      out.push_back({0, 1, 2});
-      out.push_back({0, 2, 3});
-    } else {
-      out.push_back({0, 1, 3});
-      out.push_back({1, 2, 3});
-    }
-    return;
-  }
-  std::vector<uint32_t> left(n);
-  for (uint32_t i = 0; i < n; ++i) left[i] = i;
-  if (n <= kMaxEarClipCorners) {
-    Vec3 normal{0.0f};
-    for (uint32_t i = 0; i < n; ++i) normal = normal + cross(p[i], p[(i + 1) % n]);
-    const float ax = std::fabs(normal.x), ay = std::fabs(normal.y), az = std::fabs(normal.z);
-    const int drop = ax >= ay && ax >= az ? 0 : (ay >= az ? 1 : 2);
-    const float sign = (drop == 0 ? normal.x : (drop == 1 ? normal.y : normal.z)) >= 0.0f ? 1.0f : -1.0f;
-    const auto uv = [&](uint32_t i) -> Vec2 {
-      const Vec3& q = p[i];
-      return drop == 0 ? Vec2{q.y, q.z} : (drop == 1 ? Vec2{q.z, q.x} : Vec2{q.x, q.y});
-    };
-    const auto turn = [&](Vec2 a, Vec2 b, Vec2 c) {
-      return sign * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
-    };
-    while (left.size() > 3) {
-      bool clipped = false;
-      // Ears centred on corner 1 first: a convex polygon becomes the fan around corner 0.
-      for (size_t j = 0; j < left.size() && !clipped; ++j) {
-        const size_t m = left.size(), k = (j + 1) % m;
-        const uint32_t a = left[(k + m - 1) % m], b = left[k], c = left[(k + 1) % m];
-        const Vec2 pa = uv(a), pb = uv(b), pc = uv(c);
-        if (turn(pa, pb, pc) <= 0.0f) continue;  // reflex or flat: not an ear
-        bool empty = true;
-        for (const uint32_t o : left) {
-          if (o == a || o == b || o == c) continue;
-          const Vec2 q = uv(o);
-          if (turn(pa, pb, q) >= 0.0f && turn(pb, pc, q) >= 0.0f && turn(pc, pa, q) >= 0.0f) {
-            empty = false;
-            break;
-          }
-        }
-        if (!empty) continue;
-        out.push_back({a, b, c});
-        left.erase(left.begin() + std::ptrdiff_t(k));
-        clipped = true;
-      }
-      if (!clipped) break;
-    }
-  }
-  for (size_t k = 1; k + 1 < left.size(); ++k) out.push_back({left[0], left[k], left[k + 1]});
-}
-
-}  // namespace
 
 ObjGeometry::ObjGeometry() = default;
 ObjGeometry::~ObjGeometry() = default;

@@ -1,4 +1,4 @@
-#include "scene/obj_loader.hpp"
+#include "importers/obj_loader.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +15,8 @@
 #include "base/read_input.hpp"
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
-#include "scene/mtl_parser.hpp"
-#include "scene/obj_parser.hpp"
+#include "importers/mtl_parser.hpp"
+#include "importers/obj_parser.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -36,7 +36,7 @@ std::vector<std::string> texture_names(const std::vector<MtlMaterial>& materials
 namespace fs = std::filesystem;
 
 // Resolves `mtllib` names: from files beside the OBJ (each read once, like the OBJ), or from one
-// text in memory (tests, fuzzing), by the strict MTL parser (scene/mtl_parser.hpp).
+// text in memory (tests, fuzzing), by the strict MTL parser (importers/mtl_parser.hpp).
 class MtlSource {
  public:
   static MtlSource from_directory(fs::path dir, CancelFlag cancel) {
