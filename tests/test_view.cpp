@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "driver/render_options.hpp"
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"

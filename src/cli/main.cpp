@@ -14,10 +14,13 @@
 #include "base/errors.hpp"
 #include "base/stopwatch.hpp"
 #include "cli/bench.hpp"
+#include "driver/prepare_render.hpp"
 #include "driver/progress.hpp"
 #include "driver/render_args.hpp"
 #include "driver/render_driver.hpp"
+#include "driver/render_options.hpp"
 #include "driver/render_stats.hpp"
+#include "driver/scene_setup.hpp"
 #include "driver/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
@@ -33,28 +36,15 @@ int cmd_render(const RenderArgs& args) {
   // Installed first, so a signal during loading or the build is not lost: both poll the flag.
   install_stop_handlers();
   const CancelFlag cancel = &stop_requested();
-  validate(args);
-  check_outputs(args);
-  WideBvh::force_simd_target(simd_target_for(args));
-  const ThreadLimit thread_limit(args.threads.value_or(0));
+  const PreparedRender setup(args, {.writes_outputs = true, .quiet = args.quiet, .cancel = cancel});
   if (args.threads && ThreadLimit::oversubscribed(*args.threads)) {
     std::cerr << "tracer: warning: --threads " << *args.threads << " is more than this machine's hardware threads; all "
               << *args.threads << " run, sharing them\n";
   }
-
-  const auto t_load = std::chrono::steady_clock::now();
-  LoadPhases load_phases;
-  const Scene scene = load_scene(args.scene, args.quiet, cancel, &load_phases);
-  const double load_ms = ms_since(t_load);
-  check_outputs_against_inputs(args);
-  const CameraSpec camera = camera_for(scene, args);
-  std::string lighting_note;
-  const RenderSettings settings = settings_for(args, scene, lighting_note);
-  if (!lighting_note.empty() && !args.quiet) std::cerr << "tracer: note: " << lighting_note << "\n";
-  const SchedOptions sched = sched_options_for(args);
-  AccelOptions accel_options = accel_options_for(args);
-  accel_options.bvh.cancel = cancel;
-  const Accelerator accel = build_accelerator(scene, accel_options);
+  if (!setup.lighting_note.empty() && !args.quiet) std::cerr << "tracer: note: " << setup.lighting_note << "\n";
+  const Scene& scene = setup.scene;
+  const RenderSettings& settings = setup.settings;
+  const Accelerator& accel = setup.accel;
 
   RenderControl control;
   control.cancel = cancel;
@@ -67,13 +57,13 @@ int cmd_render(const RenderArgs& args) {
     RenderContext c = ctx;
     for (const SampleRange& pass : round) {
       c.samples = pass;
-      if (!render_image(accel, c, sched, control)) return false;
+      if (!render_image(accel, c, setup.sched, control)) return false;
     }
     return true;
   };
   const FrameSequence frames{args.output,         args.frames,       args.orbit,    args.checkpoint,
                              exr_pixel_for(args), args.save_partial, aovs_for(args)};
-  const DriveResult r = drive_render(scene, camera, settings, frames, true, true, cancel, render_round,
+  const DriveResult r = drive_render(scene, setup.camera, settings, frames, true, true, cancel, render_round,
                                      [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
   if (r.stopped) {
     progress.stop();
@@ -93,8 +83,9 @@ int cmd_render(const RenderArgs& args) {
   const int checkpoints = r.checkpoints;
   progress.stop();
   const double render_ms = ms_since(t_render);
-  nlohmann::json stats = render_stats(scene, settings, accel, sched, args, load_ms, render_ms, control.counts.load(),
-                                      args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &load_phases);
+  nlohmann::json stats =
+      render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, render_ms, control.counts.load(),
+                   args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &setup.load_phases);
   stats["checkpoints_written"] = checkpoints;
   if (args.stats) print_stats(stats, accel);
   write_stats_json(args.stats_json, stats);

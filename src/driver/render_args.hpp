@@ -1,5 +1,6 @@
-// The flags shared by `tracer render` and `tracer bench`, and turning them into a scene, a camera,
-// an accelerator and a scheduler.
+// The flags of a render (tracer render, bench, view and tracer-mpi): what they are, their
+// defaults, and their check. What they become is render_options.hpp's (settings, accelerator and
+// scheduler options), scene_setup.hpp's (the scene and camera) and prepare_render.hpp's (all of it).
 #pragma once
 
 #include <optional>
@@ -11,8 +12,6 @@
 #include "importers/obj_loader.hpp"
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
-#include "render/render_tile.hpp"
-#include "scene/scene.hpp"
 
 namespace CLI {
 class Option;
@@ -74,37 +73,6 @@ void add_scene_options(CLI::App& app, SceneArgs& args);
 CLI::Option* file_option(CLI::Option* option);
 void add_render_options(CLI::App& app, RenderArgs& args);
 
-// Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.
-// "-" reads the OBJ from standard input. `quiet` drops the loader's warnings.
-Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr, LoadPhases* phases = nullptr);
-// Two paths name the same file: the same inode if both exist, else the same absolute path.
-bool same_file(const std::string& a, const std::string& b);
-// -o and --stats-json: known formats, writable, and neither of them the input scene or each other.
-void check_outputs(const RenderArgs& args);
-// Once the scene is loaded: no output (every frame's, --stats-json) is a file the load read (the
-// OBJ, its MTL files and textures, a views file), by identity; throws UsageError.
-void check_outputs_against_inputs(const RenderArgs& args);
-CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
-// Frame `frame` of `frames`: `spec` with its eye turned about the look point, around the up
-// axis, by orbit_degrees * frame / frames (so 360 over N frames loops without a repeated frame).
-CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double orbit_degrees);
-// The output of frame `frame`: `output` itself for a single frame, else NAME-0007.EXT (more digits past 10,000 frames).
-std::string frame_output(const std::string& output, int frame, int frames);
-RenderSettings settings_for(const RenderArgs& args);
-// The path integrator's samples per pixel when --spp is not given.
-inline constexpr int kDefaultPathSpp = 64;
-// settings_for() plus what depends on the scene: a path render of a scene with no emissive
-// surface and no --env is lit by a uniform white sky as well as any point lights (a point light
-// alone leaves everything it does not see black), and `note` says so.
-RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
-// Said whenever a finished image is black in every pixel: why, and the flags that light it.
-std::string black_image_warning(const RenderSettings& settings, const Scene& scene);
-AccelOptions accel_options_for(const RenderArgs& args);
-SchedOptions sched_options_for(const RenderArgs& args);
-SimdTarget simd_target_for(const RenderArgs& args);
-ExrPixel exr_pixel_for(const RenderArgs& args);
-// --aov: a comma-separated list of albedo and normal, only for path renders to .exr; throws UsageError.
-Aovs aovs_for(const RenderArgs& args);
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);
 

@@ -2,7 +2,9 @@
 
 #include <chrono>
 
+#include "driver/output_checks.hpp"
 #include "driver/render_args.hpp"
+#include "driver/render_options.hpp"
 #include "io/image_io.hpp"
 #include "scene/camera.hpp"
 

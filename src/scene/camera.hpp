@@ -23,6 +23,20 @@ inline CameraSpec frame_bounds(const Aabb& bounds, float fov_degrees = kDefaultF
   return CameraSpec{c + Vec3{0.0f, 0.0f, distance}, c, {0.0f, 1.0f, 0.0f}, fov_degrees};
 }
 
+// Frame `frame` of `frames`: `spec` with its eye turned about the look point, around the up
+// axis, by orbit_degrees * frame / frames (so 360 over N frames loops without a repeated frame).
+inline CameraSpec frame_camera(const CameraSpec& spec, int frame, int frames, double orbit_degrees) {
+  if (frames <= 1 || orbit_degrees == 0.0) return spec;
+  const double angle = orbit_degrees * double(frame) / double(frames) * std::numbers::pi / 180.0;
+  const Vec3 k = normalize(spec.up);
+  const Vec3 v = spec.eye - spec.look;
+  // Rodrigues: v cos + (k x v) sin + k (k . v)(1 - cos).
+  const float c = float(std::cos(angle)), s = float(std::sin(angle));
+  CameraSpec out = spec;
+  out.eye = spec.look + v * c + cross(k, v) * s + k * (dot(k, v) * (1.0f - c));
+  return out;
+}
+
 class Camera {
  public:
   Camera() = default;

@@ -9,8 +9,8 @@
 
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
+#include "driver/prepare_render.hpp"
 #include "driver/signals.hpp"
-#include "parallel/thread_count.hpp"
 #include "view/view_server.hpp"
 #include "view/view_session.hpp"
 
@@ -33,19 +33,11 @@ int run_view(ViewArgs args) {
   if (r.checkpoint) throw UsageError("--checkpoint: not for tracer view (save downloads the image)");
   check_range("--width", r.settings.width, 1, kMaxViewSide);
   check_range("--height", r.settings.height, 1, kMaxViewSide);
-  validate(r);
-  WideBvh::force_simd_target(simd_target_for(r));
-  const ThreadLimit thread_limit(r.threads.value_or(0));
+  const PreparedRender setup(r, {.writes_outputs = false, .quiet = r.quiet, .cancel = cancel});
+  if (!setup.lighting_note.empty() && !r.quiet) std::cerr << "tracer: note: " << setup.lighting_note << "\n";
+  const Scene& scene = setup.scene;
 
-  const Scene scene = load_scene(r.scene, r.quiet, cancel);
-  std::string note;
-  settings_for(r, scene, note);
-  if (!note.empty() && !r.quiet) std::cerr << "tracer: note: " << note << "\n";
-  AccelOptions accel_options = accel_options_for(r);
-  accel_options.bvh.cancel = cancel;
-  const Accelerator accel = build_accelerator(scene, accel_options);
-
-  ViewSession session(scene, accel, r, args.user_flags, kViewerFlags);
+  ViewSession session(scene, setup.accel, r, args.user_flags, kViewerFlags);
   ViewServer server(session, random_token());
   const int port = server.bind(args.listen, args.port);
   session.start();

@@ -7,6 +7,8 @@
 #include <cstdio>
 
 #include "base/errors.hpp"
+#include "driver/render_options.hpp"
+#include "driver/scene_setup.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
 

@@ -1,0 +1,113 @@
+#include "driver/render_options.hpp"
+
+#include "base/errors.hpp"
+#include "driver/parse.hpp"
+#include "io/image_io.hpp"
+
+namespace tracer::driver {
+
+RenderSettings settings_for(const RenderArgs& a) {
+  RenderSettings s = a.settings;
+  if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
+  s.integrator = parse_name<Integrator>(kIntegratorNames, a.integrator, "--integrator", "integrator");
+  s.light_sampling =
+      parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
+  const bool path = s.integrator == Integrator::Path;
+  if (a.checkpoint && !path) throw UsageError("--checkpoint: only for --integrator path");
+  for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--env-map", !a.scene.env_map.empty()}}) {
+    if (given && s.integrator == Integrator::Ao)
+      throw UsageError(std::string(flag) + ": only for --integrator path or whitted");
+  }
+  // Every integrator anti-aliases with --spp; ao and whitted take one centred sample by default.
+  s.spp = a.spp.value_or(path ? kDefaultPathSpp : 1);
+  if (!a.env.empty())
+    s.environment = parse_vec3("--env", a.env);
+  else if (!a.scene.env_map.empty())
+    s.environment = Vec3{1.0f};
+  // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
+  // not for whitted, whose rays go one at a time.
+  const bool by_default = s.packets && !a.no_packets && a.simd != "off";
+  s.packets =
+      (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
+  return s;
+}
+
+RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
+  RenderSettings s = settings_for(a);
+  note.clear();
+  if (s.integrator == Integrator::Path && a.env.empty() && scene.environment_map.empty() && scene.emitters.empty()) {
+    s.environment = Vec3{1.0f};
+    note = scene.source +
+           " has no emissive surface: a uniform white sky lights it too (--env 1,1,1; --env 0,0,0 for none)";
+  }
+  return s;
+}
+
+std::string black_image_warning(const RenderSettings& s, const Scene& scene) {
+  std::string why;
+  if (s.integrator == Integrator::Path) {
+    why = scene.emitters.empty() && max_component(s.environment) == 0.0f
+              ? "the scene has no emissive surface and --env is black"
+              : "no light reaches what the camera sees (an emitter out of view or too small, or --exposure too low)";
+  } else {
+    why = scene.lights.empty() && s.ambient == 0.0f ? "the scene has no light and --ambient is 0"
+                                                    : "no light reaches what the camera sees";
+  }
+  return "the image is black: " + why +
+         "; --integrator path --env 1,1,1 lights it with a white sky, --light x,y,z adds a point light";
+}
+
+Aovs aovs_for(const RenderArgs& a) {
+  Aovs aovs;
+  if (a.aov.empty()) return aovs;
+  for (const std::string& name : split_list("--aov", a.aov)) {
+    if (name == "albedo") {
+      aovs.albedo = true;
+    } else if (name == "normal") {
+      aovs.normal = true;
+    } else {
+      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal)");
+    }
+  }
+  if (a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {
+    throw UsageError("--aov: only for --integrator path");
+  }
+  if (image_format_for(a.output) != ImageFormat::Exr) throw UsageError("--aov: the layers need an .exr output (-o)");
+  return aovs;
+}
+
+AccelOptions accel_options_for(const RenderArgs& a) {
+  AccelOptions o;
+  o.bvh = a.bvh;
+  const std::string simd = a.simd;
+  if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
+
+  // --simd off alone asks for the scalar baseline: the binary BVH, not the SIMD default.
+  const AccelKind fallback = simd == "off" ? AccelKind::Bvh : o.kind;
+  o.kind = a.accel ? parse_name<AccelKind>(kAccelKindNames, *a.accel, "--accel", "accelerator") : fallback;
+  if (o.kind == AccelKind::BruteSimd && simd == "off") o.kind = AccelKind::Brute;
+  if (o.kind == AccelKind::Bvh8 && simd == "off") {
+    throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
+  }
+  o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
+  o.bvh.mode = parse_name<BuildMode>(kBuildModeNames, a.build, "--build", "builder");
+  o.bvh.threads = a.threads.value_or(0);
+  return o;
+}
+
+SchedOptions sched_options_for(const RenderArgs& a) {
+  SchedOptions o = a.sched;
+  o.kind = parse_name<SchedKind>(kSchedKindNames, a.sched_kind, "--sched", "scheduler");
+  o.threads = a.threads.value_or(0);
+  return o;
+}
+
+ExrPixel exr_pixel_for(const RenderArgs& a) {
+  return parse_name<ExrPixel>(kExrPixelNames, a.exr, "--exr", "pixel type");
+}
+
+SimdTarget simd_target_for(const RenderArgs& a) {
+  return parse_name<SimdTarget>(kSimdTargetNames, a.simd_target, "--simd-target", "target");
+}
+
+}  // namespace tracer::driver

@@ -1,0 +1,26 @@
+// What a render's flags become: the RenderSettings, and the accelerator's, scheduler's and
+// output's options.
+#pragma once
+
+#include "driver/render_args.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer::driver {
+
+RenderSettings settings_for(const RenderArgs& args);
+// The path integrator's samples per pixel when --spp is not given.
+inline constexpr int kDefaultPathSpp = 64;
+// settings_for() plus what depends on the scene: a path render of a scene with no emissive
+// surface and no --env is lit by a uniform white sky as well as any point lights (a point light
+// alone leaves everything it does not see black), and `note` says so.
+RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
+// Said whenever a finished image is black in every pixel: why, and the flags that light it.
+std::string black_image_warning(const RenderSettings& settings, const Scene& scene);
+AccelOptions accel_options_for(const RenderArgs& args);
+SchedOptions sched_options_for(const RenderArgs& args);
+SimdTarget simd_target_for(const RenderArgs& args);
+ExrPixel exr_pixel_for(const RenderArgs& args);
+// --aov: a comma-separated list of albedo and normal, only for path renders to .exr; throws UsageError.
+Aovs aovs_for(const RenderArgs& args);
+
+}  // namespace tracer::driver
