@@ -22,7 +22,7 @@ Framebuffer render_path(const Scene& scene, const CameraSpec& cam, RenderSetting
   RenderControl control;
   SchedOptions so;
   so.kind = SchedKind::Tbb;
-  EXPECT_TRUE(render_passes(build_accelerator(scene, AccelOptions{}), ctx, so, control));
+  EXPECT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), so, control));
   return fb;
 }
 
@@ -184,7 +184,7 @@ TEST(Path, WhittedSeesTheEnvironmentWhereNothingIsHit) {
   const Camera camera(CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 60.0f}, s.width, s.height);
   RenderContext ctx{&scene, camera, s, &fb};
   RenderControl control;
-  ASSERT_TRUE(render_passes(build_accelerator(scene, AccelOptions{}), ctx, SchedOptions{}, control));
+  ASSERT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), SchedOptions{}, control));
   const Ray corner = camera.primary_ray(0, 0);
   const Vec3 expected = scene.environment_map.radiance(corner.dir) * 0.5f;
   EXPECT_EQ(fb.radiance(0, 0).x, expected.x);

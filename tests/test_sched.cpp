@@ -136,7 +136,7 @@ std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const S
   const CameraSpec cam = scene.camera ? *scene.camera : CameraSpec{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
   RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
   RenderControl control;
-  EXPECT_TRUE(render_passes(acc, ctx, so, control));
+  EXPECT_TRUE(render_round(acc, ctx, sample_passes(s), so, control));
   EXPECT_EQ(fb.min_samples(), uint32_t(s.spp));
   std::vector<float> sums;
   for (size_t i = 0; i < fb.pixel_count(); ++i) {

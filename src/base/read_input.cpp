@@ -54,7 +54,15 @@ void remember_input(const struct stat& st, const std::string& name) {
 
 std::string mib(uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 
-InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_bytes, bool map, bool remember = true) {
+// How read_or_map() takes a file: mapped (else read into memory), and remembered as an input
+// (else an output read back, which no later output may name).
+struct ReadMode {
+  bool map = false;
+  bool remember = true;
+};
+
+InputBytes read_or_map(const std::string& path, CancelFlag cancel, uint64_t max_bytes, ReadMode mode) {
+  const bool map = mode.map, remember = mode.remember;
   const bool stdin_input = path == "-";
   const std::string name = stdin_input ? "<stdin>" : path;
   if (path.empty()) throw InputError("an empty file name was given");
@@ -136,15 +144,15 @@ InputBytes& InputBytes::operator=(InputBytes&& o) noexcept {
 }
 
 std::string read_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
-  return read_or_map(path, cancel, max_bytes, false).release();
+  return read_or_map(path, cancel, max_bytes, {.map = false}).release();
 }
 
 InputBytes map_input(const std::string& path, CancelFlag cancel, uint64_t max_bytes) {
-  return read_or_map(path, cancel, max_bytes, true);
+  return read_or_map(path, cancel, max_bytes, {.map = true});
 }
 
 std::string read_back(const std::string& path, uint64_t max_bytes) {
-  return read_or_map(path, nullptr, max_bytes, false, false).release();
+  return read_or_map(path, nullptr, max_bytes, {.map = false, .remember = false}).release();
 }
 
 void check_not_an_input(const std::string& path, const std::string& flag) {

@@ -70,7 +70,7 @@ int run_bench(const BenchArgs& a) {
   if (a.threads) check_range("--threads", *a.threads, 1, 1024);
   const int threads = a.threads.value_or(0);
   const ThreadLimit thread_limit(threads);
-  check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, true);
+  check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, LowEnd::Open);
   const std::vector<Variant> variants = resolve_variants(a.variants);
   const std::vector<SceneEntry> scenes = resolve_scenes(a);
   const std::pair<const std::string*, const char*> outputs[] = {

@@ -53,17 +53,13 @@ int cmd_render(const RenderArgs& args) {
       uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
   ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
   // Every pass a round of its own: checkpoints, and a complete image after the first on Ctrl-C.
-  const auto render_round = [&](const RenderContext& ctx, const std::vector<SampleRange>& round) {
-    RenderContext c = ctx;
-    for (const SampleRange& pass : round) {
-      c.samples = pass;
-      if (!render_image(accel, c, setup.sched, control)) return false;
-    }
-    return true;
+  const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
+    return render_round(accel, ctx, passes, setup.sched, control);
   };
   const FrameSequence frames{args.output,         args.frames,       args.orbit,    args.checkpoint,
                              exr_pixel_for(args), args.save_partial, aovs_for(args)};
-  const DriveResult r = drive_render(scene, setup.camera, settings, frames, true, true, cancel, render_round,
+  const DriveResult r = drive_render(scene, setup.camera, settings, frames,
+                                     {.holds_image = true, .round_per_pass = true, .cancel = cancel}, round,
                                      [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
   if (r.stopped) {
     progress.stop();
@@ -93,7 +89,7 @@ int cmd_render(const RenderArgs& args) {
 }
 
 int cmd_info(const SceneArgs& args) {
-  const Scene scene = load_scene(args, false);
+  const Scene scene = load_scene(args, /*quiet=*/false);
   std::printf("scene       %s\n", scene.source.c_str());
   std::printf("triangles   %zu (%zu degenerate)\n", scene.size(), scene.degenerate_count);
   std::printf("vertices    %zu\n", scene.vertex_count);

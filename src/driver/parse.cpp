@@ -80,7 +80,8 @@ void check_range(const std::string& flag, long long value, long long lo, long lo
   }
 }
 
-void check_range_real(const std::string& flag, double value, double lo, double hi, bool lo_open) {
+void check_range_real(const std::string& flag, double value, double lo, double hi, LowEnd low) {
+  const bool lo_open = low == LowEnd::Open;
   const bool below = lo_open ? !(value > lo) : !(value >= lo);
   if (below || !(value <= hi) || !std::isfinite(value)) {
     std::ostringstream s;

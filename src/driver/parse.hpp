@@ -17,6 +17,8 @@ std::vector<std::string> split_list(const std::string& flag, const std::string& 
 // A position (--eye, --look, --light): three finite numbers within the supported coordinate range.
 Vec3 parse_point(const std::string& flag, const std::string& text);
 void check_range(const std::string& flag, long long value, long long lo, long long hi);
-void check_range_real(const std::string& flag, double value, double lo, double hi, bool lo_open = false);
+// Whether a range's low end is a value it holds (Closed) or only bounds it (Open: --exposure 0 is refused).
+enum class LowEnd { Closed, Open };
+void check_range_real(const std::string& flag, double value, double lo, double hi, LowEnd low = LowEnd::Closed);
 
 }  // namespace tracer::driver

@@ -155,17 +155,17 @@ void validate(const RenderArgs& a) {
   check_range("--frames", a.frames, 1, 1'000'000);
   check_range_real("--orbit", a.orbit, -1e6, 1e6);
   check_range_real("--env-rotation", a.scene.env_rotation, -1e6, 1e6);
-  if (a.checkpoint) check_range_real("--checkpoint", *a.checkpoint, 0.0, 1e9, true);
+  if (a.checkpoint) check_range_real("--checkpoint", *a.checkpoint, 0.0, 1e9, LowEnd::Open);
   if (!a.env.empty()) {
     const Vec3 env = parse_vec3("--env", a.env);
     if (env.x < 0.0f || env.y < 0.0f || env.z < 0.0f || max_component(env) > 1e30f) {
       throw UsageError("--env: each component must be in [0, 1e30], got '" + a.env + "'");
     }
   }
-  if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, true);
+  if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, LowEnd::Open);
   if (a.fov) check_range_real("--fov", *a.fov, 1e-3, 179.0);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
-  check_range_real("--exposure", s.exposure, 0.0, 1e6, true);
+  check_range_real("--exposure", s.exposure, 0.0, 1e6, LowEnd::Open);
   check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);
   if (a.scene.light_intensity) check_range_real("--light-intensity", *a.scene.light_intensity, 0.0, 1e30);
   if (a.threads) check_range("--threads", *a.threads, 1, 1024);
@@ -173,7 +173,7 @@ void validate(const RenderArgs& a) {
   check_range("--block", a.sched.block, 1, 1 << 20);
   check_range("--max-leaf", a.bvh.max_leaf, 1, 16);
   check_range("--bins", a.bvh.bins, 4, 32);
-  check_range_real("--traversal-cost", a.bvh.traversal_cost, 0.0, 100.0, true);
+  check_range_real("--traversal-cost", a.bvh.traversal_cost, 0.0, 100.0, LowEnd::Open);
   if (!a.eye.empty()) parse_point("--eye", a.eye);
   if (!a.look.empty()) parse_point("--look", a.look);
   if (!a.up.empty()) {

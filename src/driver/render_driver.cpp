@@ -19,17 +19,17 @@ std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, 
 }
 
 DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const RenderSettings& settings,
-                         const FrameSequence& seq, bool holds_image, bool round_per_pass, CancelFlag cancel,
-                         const RenderRound& render_round, const std::function<void(const std::string&)>& warn) {
+                         const FrameSequence& seq, const DriveOptions& options, const RenderRound& render_round,
+                         const std::function<void(const std::string&)>& warn) {
   using Clock = std::chrono::steady_clock;
   DriveResult result;
   bool warned_black = false, warned_clamped = false;
   for (int frame = 0; frame < seq.frames; ++frame) {
     const std::string output = frame_output(seq.output, frame, seq.frames);
     std::optional<Framebuffer> fb, albedo, normal;
-    if (holds_image) fb.emplace(settings.width, settings.height);
-    if (holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
-    if (holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
+    if (options.holds_image) fb.emplace(settings.width, settings.height);
+    if (options.holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
+    if (options.holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
     const Camera cam(frame_camera(camera, frame, seq.frames, seq.orbit_degrees), settings.width, settings.height);
     RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
     ctx.albedo = albedo ? &*albedo : nullptr;
@@ -49,7 +49,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     };
     auto last_write = Clock::now();
     uint32_t done = 0;
-    for (const std::vector<SampleRange>& round : rounds_of(settings, round_per_pass)) {
+    for (const std::vector<SampleRange>& round : rounds_of(settings, options.round_per_pass)) {
       if (!render_round(ctx, round)) {
         result.stopped = true;
         result.output = output;
@@ -79,7 +79,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
       warn(output + ": " + black_image_warning(settings, scene));
       warned_black = true;
     }
-    if (is_cancelled(cancel)) {  // arrived during the write, which is never torn
+    if (is_cancelled(options.cancel)) {  // arrived during the write, which is never torn
       result.stopped = result.stopped_after_write = true;
       result.output = output;
       return result;

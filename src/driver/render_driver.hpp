@@ -47,12 +47,18 @@ struct DriveResult {
   bool wrote_partial = false;
 };
 
-// Drives every frame. `holds_image`: this process keeps the image and writes it (false on the
-// worker ranks of an MPI job); `round_per_pass`: each pass a round of its own (checkpoints,
-// Ctrl-C after the first pass), else one round of every pass. `warn` receives one-line warnings.
+// How this process takes part in a render.
+struct DriveOptions {
+  bool holds_image = true;     // keeps the image and writes it (false on the worker ranks of an MPI job)
+  bool round_per_pass = true;  // each pass a round of its own (checkpoints, Ctrl-C after the first
+                               // pass), else one round of every pass
+  CancelFlag cancel = nullptr;
+};
+
+// Drives every frame. `warn` receives one-line warnings.
 DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const RenderSettings& settings,
-                         const FrameSequence& frames, bool holds_image, bool round_per_pass, CancelFlag cancel,
-                         const RenderRound& render_round, const std::function<void(const std::string&)>& warn);
+                         const FrameSequence& frames, const DriveOptions& options, const RenderRound& render_round,
+                         const std::function<void(const std::string&)>& warn);
 
 // The rounds of passes of a frame (sample_passes, grouped as drive_render says).
 std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool round_per_pass);

@@ -60,7 +60,8 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const driver::FrameSequence frames{args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args),
                                      false};
   const driver::DriveResult driven = driver::drive_render(
-      prepared.scene, prepared.camera, prepared.settings, frames, session.root(), args.checkpoint.has_value(), nullptr,
+      prepared.scene, prepared.camera, prepared.settings, frames,
+      {.holds_image = session.root(), .round_per_pass = args.checkpoint.has_value(), .cancel = nullptr},
       [&](const RenderContext& ctx, const std::vector<SampleRange>& round) { return rank.render_round(ctx, round); },
       [](const std::string& w) { say("tracer-mpi: warning: " + w); });
   rank.report_late_ranks();

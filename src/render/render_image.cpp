@@ -43,12 +43,11 @@ std::vector<SampleRange> sample_passes(const RenderSettings& settings) {
   return passes;
 }
 
-bool render_passes(const Accelerator& accel, RenderContext ctx, const SchedOptions& options, RenderControl& control,
-                   const std::function<void(uint32_t)>& after_pass) {
-  for (const SampleRange& pass : sample_passes(ctx.settings)) {
+bool render_round(const Accelerator& accel, RenderContext ctx, const std::vector<SampleRange>& round,
+                  const SchedOptions& options, RenderControl& control) {
+  for (const SampleRange& pass : round) {
     ctx.samples = pass;
     if (!render_image(accel, ctx, options, control)) return false;
-    if (after_pass) after_pass(pass.first + pass.count);
   }
   return true;
 }

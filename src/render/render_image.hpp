@@ -36,10 +36,11 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
 inline constexpr uint32_t kMaxPassSamples = 64;
 std::vector<SampleRange> sample_passes(const RenderSettings& settings);
 
-// Every pass of sample_passes(), in order; after each finished pass calls after_pass with the
-// samples per pixel so far. Returns false if cancelled (the framebuffer then holds the finished
-// passes plus whatever tiles of the stopped one completed).
-bool render_passes(const Accelerator& accel, RenderContext ctx, const SchedOptions& options, RenderControl& control,
-                   const std::function<void(uint32_t)>& after_pass = {});
+// The passes of `round` (some of sample_passes(), in order) of every pixel into ctx.framebuffer,
+// each by render_image(): what tracer render does with each round of the render driver. Returns
+// false if cancelled (the framebuffer then holds the finished passes plus whatever tiles of the
+// stopped one completed).
+bool render_round(const Accelerator& accel, RenderContext ctx, const std::vector<SampleRange>& round,
+                  const SchedOptions& options, RenderControl& control);
 
 }  // namespace tracer

@@ -90,18 +90,22 @@ class Bsdf {
     if (wo.z <= 0.0f) return false;
     switch (kind_) {
       case Kind::Mirror:
-        out = {frame_.to_world({-wo.x, -wo.y, wo.z}), ks_, 1.0f, true, false};
+        out = {.wi = frame_.to_world({-wo.x, -wo.y, wo.z}), .weight = ks_, .pdf = 1.0f, .delta = true};
         return true;
       case Kind::Dielectric: {
         const float f = fresnel_dielectric(wo.z, 1.0f, eta_);
         if (u_lobe < f) {
-          out = {frame_.to_world({-wo.x, -wo.y, wo.z}), Vec3{1.0f}, f, true, false};
+          out = {.wi = frame_.to_world({-wo.x, -wo.y, wo.z}), .weight = Vec3{1.0f}, .pdf = f, .delta = true};
           return true;
         }
         Vec3 wt;
         if (!refract(-wo, Vec3{0.0f, 0.0f, 1.0f}, 1.0f / eta_, wt)) return false;  // f was 1: not reached
         // Radiance scales by 1/eta^2 crossing into the denser side (it is L/n^2 that is conserved).
-        out = {frame_.to_world(wt), kd_ / (eta_ * eta_), 1.0f - f, true, true};
+        out = {.wi = frame_.to_world(wt),
+               .weight = kd_ / (eta_ * eta_),
+               .pdf = 1.0f - f,
+               .delta = true,
+               .transmitted = true};
         return true;
       }
       case Kind::Smooth:
@@ -119,7 +123,7 @@ class Bsdf {
     const Vec3 wi_world = frame_.to_world(wi);
     const float p = pdf(wo_world, wi_world);
     if (!(p > 0.0f)) return false;
-    out = {wi_world, eval(wo_world, wi_world) / p, p, false, false};
+    out = {.wi = wi_world, .weight = eval(wo_world, wi_world) / p, .pdf = p};
     return true;
   }
 

@@ -23,6 +23,9 @@ namespace tracer::view {
 
 namespace {
 
+// The two downloads of the current image: tone-mapped PNG, or linear EXR.
+enum class ImageFile { Png, Exr };
+
 // The page, its script and style: src/view/page.html, embedded at build time.
 constexpr const char kPage[] =
 #include <view_page.inc>  // generated from src/view/page.html (CMakeLists.txt)
@@ -337,7 +340,8 @@ void ViewServer::add_routes() {
         },
         [this](bool) { streams_.fetch_sub(1); });
   });
-  const auto image = [this](bool exr) {
+  const auto image = [this](ImageFile file) {
+    const bool exr = file == ImageFile::Exr;
     return [this, exr](const httplib::Request&, httplib::Response& res) {
       const std::optional<ViewSession::Snapshot> snap = session_.snapshot();
       if (!snap) {
@@ -354,8 +358,8 @@ void ViewServer::add_routes() {
       }
     };
   };
-  s.Get("/image.png", image(false));
-  s.Get("/image.exr", image(true));
+  s.Get("/image.png", image(ImageFile::Png));
+  s.Get("/image.exr", image(ImageFile::Exr));
 }
 
 }  // namespace tracer::view
