@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "accel/bvh.hpp"
+#include "accel/bvh/bvh.hpp"
 #include "base/errors.hpp"
 #include "importers/obj_loader.hpp"
 #include "scene/scene_checksum.hpp"

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
-#include "accel/triangle_test.hpp"
+#include "accel/kernels/triangle_test.hpp"
 #include "base/errors.hpp"
 #include "importers/obj_loader.hpp"
 

@@ -11,8 +11,8 @@
 #include <variant>
 
 #include "accel/brute_force.hpp"
-#include "accel/bvh.hpp"
-#include "accel/wide_bvh.hpp"
+#include "accel/bvh/bvh.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 #ifdef TRACER_HAVE_EMBREE
 #include "accel/embree_accel.hpp"
 #endif

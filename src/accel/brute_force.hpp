@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "accel/triangle_test.hpp"
+#include "accel/kernels/triangle_test.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {

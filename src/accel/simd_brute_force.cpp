@@ -8,8 +8,8 @@
 #include <algorithm>
 
 #include "accel/brute_force.hpp"
-#include "accel/wide_bvh.hpp"
-#include "accel/wide_bvh_kernels-inl.h"
+#include "accel/wide_bvh/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_kernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

@@ -5,7 +5,7 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "accel/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

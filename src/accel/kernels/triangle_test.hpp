@@ -7,7 +7,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "accel/lane_kernels.hpp"
+#include "accel/kernels/lane_kernels.hpp"
 #include "math/ray.hpp"
 #include "scene/scene.hpp"
 

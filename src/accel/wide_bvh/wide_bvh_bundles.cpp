@@ -1,15 +1,15 @@
 // The 8-wide BVH's AO bundles: up to 16 rays leaving one point searched top-down together while
 // many of them enter the same nodes (docs/RENDERING.md, "Packets"), compiled once per SIMD target.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "accel/wide_bvh_bundles.cpp"
+#define HWY_TARGET_INCLUDE "accel/wide_bvh/wide_bvh_bundles.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
 #include <bit>
 
-#include "accel/ray_bundle-inl.h"
-#include "accel/wide_bvh.hpp"
-#include "accel/wide_bvh_kernels-inl.h"
+#include "accel/kernels/ray_bundle-inl.h"
+#include "accel/wide_bvh/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_kernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

@@ -13,7 +13,7 @@
 
 #include <cstdint>
 
-#include "accel/lane_kernels.hpp"
+#include "accel/kernels/lane_kernels.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -21,7 +21,7 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // The kernels, compiled for this target.
-#include "accel/lane_kernels-inl.h"  // NOLINT(build/include): a per-target copy, see that file
+#include "accel/kernels/lane_kernels-inl.h"  // NOLINT(build/include): a per-target copy, see that file
 
 // lane_kernels.hpp's lane operations on Highway vectors of tag D.
 template <class D>
@@ -68,6 +68,21 @@ HWY_INLINE hn::Mask<D> LaneMask(D d, uint32_t bits) {
 // Bits [first, first + lanes) of `mask`, shifted down: one vector's share of a 16-lane set.
 HWY_INLINE uint32_t ChunkBits(uint32_t mask, size_t first, size_t lanes) {
   return (mask >> first) & (lanes >= 32 ? ~0u : (1u << lanes) - 1u);
+}
+
+// The slab test's near and far planes of the box [lo, hi] for the rays of lanes [i, i + N): each
+// ray enters a slab at hi where its direction is negative (nx, ny, nz: -1 there, else 0) and at lo
+// elsewhere. Written once for every traversal that follows several rays as lanes.
+template <class D>
+HWY_INLINE void NearFarPlanes(D d, const int32_t* nx, const int32_t* ny, const int32_t* nz, size_t i,
+                              const Lanes3<hn::Vec<D>>& lo, const Lanes3<hn::Vec<D>>& hi, Lanes3<hn::Vec<D>>& near,
+                              Lanes3<hn::Vec<D>>& far) {
+  const hn::RebindToSigned<D> di;
+  const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, nx + i), hn::Zero(di)));
+  const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, ny + i), hn::Zero(di)));
+  const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, nz + i), hn::Zero(di)));
+  near = {hn::IfThenElse(negx, hi.x, lo.x), hn::IfThenElse(negy, hi.y, lo.y), hn::IfThenElse(negz, hi.z, lo.z)};
+  far = {hn::IfThenElse(negx, lo.x, hi.x), hn::IfThenElse(negy, lo.y, hi.y), hn::IfThenElse(negz, lo.z, hi.z)};
 }
 
 }  // namespace HWY_NAMESPACE

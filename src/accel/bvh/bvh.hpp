@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "accel/lane_kernels.hpp"
-#include "accel/triangle_test.hpp"
+#include "accel/kernels/lane_kernels.hpp"
+#include "accel/kernels/triangle_test.hpp"
 #include "base/enum_names.hpp"
 #include "base/errors.hpp"
 #include "base/huge_pages.hpp"

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 namespace tracer {
 

@@ -1,11 +1,11 @@
 // The 8-wide BVH's single-ray kernels, closest hit and any hit, compiled once per SIMD target.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "accel/wide_bvh_traverse.cpp"
+#define HWY_TARGET_INCLUDE "accel/wide_bvh/wide_bvh_traverse.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "accel/wide_bvh.hpp"
-#include "accel/wide_bvh_kernels-inl.h"
+#include "accel/wide_bvh/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_kernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

@@ -36,6 +36,6 @@ struct SlabGuards {
 };
 
 // The kernels for scalar code (SIMD code gets its own per-target copy through simd_lanes-inl.h).
-#include "accel/lane_kernels-inl.h"  // IWYU pragma: export
+#include "accel/kernels/lane_kernels-inl.h"  // IWYU pragma: export
 
 }  // namespace tracer

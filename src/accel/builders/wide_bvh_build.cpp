@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "accel/prim_split.hpp"
-#include "accel/wide_bvh.hpp"
+#include "accel/builders/prim_split.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 namespace tracer {
 

@@ -9,14 +9,14 @@
 // one scalar per plane), and triangles are tested by the scalar watertight test per lane, so
 // every ray gets the answer it gets alone.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "accel/bvh_bundles.cpp"
+#define HWY_TARGET_INCLUDE "accel/bvh/bvh_bundles.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
 #include <bit>
 
-#include "accel/bvh.hpp"
-#include "accel/ray_bundle-inl.h"
+#include "accel/bvh/bvh.hpp"
+#include "accel/kernels/ray_bundle-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

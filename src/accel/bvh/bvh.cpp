@@ -1,5 +1,5 @@
 // BVH traversal, statistics and validation. The build is in bvh_builder.cpp.
-#include "accel/bvh.hpp"
+#include "accel/bvh/bvh.hpp"
 
 #include <sstream>
 

@@ -14,7 +14,7 @@
 
 #include <immintrin.h>  // SSE2, part of every x86-64
 
-#include "accel/bvh.hpp"
+#include "accel/bvh/bvh.hpp"
 #include "base/huge_pages.hpp"
 
 namespace tracer {

@@ -14,9 +14,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "accel/bvh.hpp"
-#include "accel/simd_lanes-inl.h"
-#include "accel/triangle_test.hpp"
+#include "accel/bvh/bvh.hpp"
+#include "accel/kernels/simd_lanes-inl.h"
+#include "accel/kernels/triangle_test.hpp"
 #include "math/ray_packet.hpp"
 
 HWY_BEFORE_NAMESPACE();
@@ -100,7 +100,6 @@ struct BundleState {
 HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const BundleState& st, uint32_t mask) {
   const hn::ScalableTag<float> d;
   using L = SimdLanes<decltype(d)>;
-  const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const auto lo_x = hn::Set(d, lo[0] - st.org[0]), lo_y = hn::Set(d, lo[1] - st.org[1]),
              lo_z = hn::Set(d, lo[2] - st.org[2]);
@@ -111,13 +110,8 @@ HWY_INLINE uint32_t TestBundleBox(const float lo[3], const float hi[3], const Bu
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
-    const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nx + i), hn::Zero(di)));
-    const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
-    const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nz + i), hn::Zero(di)));
-    const Lanes3<L::V> near{hn::IfThenElse(negx, hi_x, lo_x), hn::IfThenElse(negy, hi_y, lo_y),
-                            hn::IfThenElse(negz, hi_z, lo_z)};
-    const Lanes3<L::V> far{hn::IfThenElse(negx, lo_x, hi_x), hn::IfThenElse(negy, lo_y, hi_y),
-                           hn::IfThenElse(negz, lo_z, hi_z)};
+    Lanes3<L::V> near, far;
+    NearFarPlanes(d, st.nx, st.ny, st.nz, i, {lo_x, lo_y, lo_z}, {hi_x, hi_y, hi_z}, near, far);
     const Lanes3<L::V> inv{hn::Load(d, st.ix + i), hn::Load(d, st.iy + i), hn::Load(d, st.iz + i)};
     const Lanes3<L::V> inv_far{hn::Load(d, st.fx + i), hn::Load(d, st.fy + i), hn::Load(d, st.fz + i)};
     L::V t0;

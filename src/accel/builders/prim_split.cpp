@@ -1,5 +1,5 @@
 // The binned SAH and object-median splits shared by the binary and 8-wide BVH builders.
-#include "accel/prim_split.hpp"
+#include "accel/builders/prim_split.hpp"
 
 #include <algorithm>
 #include <utility>

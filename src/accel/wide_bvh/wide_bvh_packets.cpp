@@ -7,14 +7,14 @@
 // triangle_test.hpp, closer()), so each ray gets the hit it gets alone, bit for bit. Packets whose
 // rays do not share the shear axes of that test (rare for primary rays) are traced ray by ray.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "accel/wide_bvh_packets.cpp"
+#define HWY_TARGET_INCLUDE "accel/wide_bvh/wide_bvh_packets.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
 #include <cmath>
 
-#include "accel/simd_lanes-inl.h"
-#include "accel/wide_bvh.hpp"
+#include "accel/kernels/simd_lanes-inl.h"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
@@ -46,7 +46,6 @@ constexpr int32_t kFlip = INT32_MIN;
 HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState& st, uint32_t mask, float& entry) {
   const hn::ScalableTag<float> d;
   using L = SimdLanes<decltype(d)>;
-  const hn::RebindToSigned<decltype(d)> di;
   const size_t N = hn::Lanes(d);
   const auto lo_x = hn::Set(d, n.lo_x[c]), lo_y = hn::Set(d, n.lo_y[c]), lo_z = hn::Set(d, n.lo_z[c]);
   const auto hi_x = hn::Set(d, n.hi_x[c]), hi_y = hn::Set(d, n.hi_y[c]), hi_z = hn::Set(d, n.hi_z[c]);
@@ -55,14 +54,10 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
-    const auto negx = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nx + i), hn::Zero(di)));
-    const auto negy = hn::RebindMask(d, hn::Lt(hn::Load(di, st.ny + i), hn::Zero(di)));
-    const auto negz = hn::RebindMask(d, hn::Lt(hn::Load(di, st.nz + i), hn::Zero(di)));
     const auto ox = hn::Load(d, st.ox + i), oy = hn::Load(d, st.oy + i), oz = hn::Load(d, st.oz + i);
-    const Lanes3<L::V> near{hn::IfThenElse(negx, hi_x, lo_x) - ox, hn::IfThenElse(negy, hi_y, lo_y) - oy,
-                            hn::IfThenElse(negz, hi_z, lo_z) - oz};
-    const Lanes3<L::V> far{hn::IfThenElse(negx, lo_x, hi_x) - ox, hn::IfThenElse(negy, lo_y, hi_y) - oy,
-                           hn::IfThenElse(negz, lo_z, hi_z) - oz};
+    Lanes3<L::V> near, far;  // each lane's planes relative to its own origin
+    NearFarPlanes(d, st.nx, st.ny, st.nz, i, {lo_x - ox, lo_y - oy, lo_z - oz}, {hi_x - ox, hi_y - oy, hi_z - oz}, near,
+                  far);
     const Lanes3<L::V> inv{hn::Load(d, st.ix + i), hn::Load(d, st.iy + i), hn::Load(d, st.iz + i)};
     const Lanes3<L::V> inv_far{hn::Load(d, st.fx + i), hn::Load(d, st.fy + i), hn::Load(d, st.fz + i)};
     L::V t0;

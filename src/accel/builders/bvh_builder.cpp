@@ -12,8 +12,8 @@
 #include <memory>
 #include <utility>
 
-#include "accel/bvh.hpp"
-#include "accel/prim_split.hpp"
+#include "accel/builders/prim_split.hpp"
+#include "accel/bvh/bvh.hpp"
 
 namespace tracer {
 namespace {

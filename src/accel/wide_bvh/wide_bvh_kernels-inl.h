@@ -19,9 +19,9 @@
 #include <cstddef>
 #include <limits>
 
-#include "accel/simd_lanes-inl.h"
-#include "accel/triangle_test.hpp"
-#include "accel/wide_bvh.hpp"
+#include "accel/kernels/simd_lanes-inl.h"
+#include "accel/kernels/triangle_test.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

@@ -1,7 +1,7 @@
 // Packing triangles eight to a SIMD pack (SoA), for the 8-wide BVH's leaves and SIMD brute force.
 #include <limits>
 
-#include "accel/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 
 namespace tracer {
 

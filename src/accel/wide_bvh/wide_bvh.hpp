@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/bvh.hpp"
+#include "accel/bvh/bvh.hpp"
 #include "math/ray_packet.hpp"
 
 namespace tracer {
