@@ -50,13 +50,18 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       acc.name = "bvh8-" + WideBvh::simd_target();
       break;
     case AccelKind::Embree:
+    case AccelKind::EmbreeHigh: {
+      const bool high = options.kind == AccelKind::EmbreeHigh;
 #ifdef TRACER_HAVE_EMBREE
-      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene, options.bvh.cancel);
-      acc.name = "embree";
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene, options.bvh.cancel, nullptr,
+                                                high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+      acc.name = high ? "embree-high" : "embree";
       break;
 #else
-      throw UsageError("--accel embree: this build has no Embree (configure with -DTRACER_EMBREE=ON)");
+      throw UsageError(std::string("--accel ") + (high ? "embree-high" : "embree") +
+                       ": this build has no Embree (configure with -DTRACER_EMBREE=ON)");
 #endif
+    }
   }
   acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return acc;

@@ -25,10 +25,15 @@ concept RayAccelerator = requires(const A& a, const Ray& r, Hit& h) {
   { a.occluded(r) } -> std::same_as<bool>;
 };
 
-enum class AccelKind { Brute, BruteSimd, Bvh, Bvh8, Embree };
+// EmbreeHigh is Embree built at its HIGH quality (spatial splits): the reference at its best.
+enum class AccelKind { Brute, BruteSimd, Bvh, Bvh8, Embree, EmbreeHigh };
 // The names --accel takes: "brute" is BruteSimd unless --simd off asks for the scalar Brute.
-inline constexpr EnumName<AccelKind> kAccelKindNames[] = {
-    {AccelKind::BruteSimd, "brute"}, {AccelKind::Bvh, "bvh"}, {AccelKind::Bvh8, "bvh8"}, {AccelKind::Embree, "embree"}};
+inline constexpr EnumName<AccelKind> kAccelKindNames[] = {{AccelKind::BruteSimd, "brute"},
+                                                          {AccelKind::Bvh, "bvh"},
+                                                          {AccelKind::Bvh8, "bvh8"},
+                                                          {AccelKind::Embree, "embree"},
+                                                          {AccelKind::EmbreeHigh, "embree-high"}};
+inline bool is_embree(AccelKind kind) { return kind == AccelKind::Embree || kind == AccelKind::EmbreeHigh; }
 
 struct AccelOptions {
   AccelKind kind = AccelKind::Bvh8;  // the fastest (docs/BENCHMARKS.md section 1)
@@ -61,7 +66,7 @@ bool embree_available();
 
 // Whether `kind` traces packets or bundles (--packets): the BVHs and Embree.
 inline bool has_packet_kernels(AccelKind kind) {
-  return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || kind == AccelKind::Embree;
+  return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || is_embree(kind);
 }
 
 // Builds the accelerator `options` asks for, timing the build. Throws UsageError if it is not

@@ -16,12 +16,14 @@ bool EmbreeAccel::monitor(void* user, ssize_t bytes, bool /*post*/) {
   return true;
 }
 
-EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel, const char* device_config) : scene_(&scene) {
+EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel, const char* device_config, RTCBuildQuality quality)
+    : scene_(&scene) {
   device_ = rtcNewDevice(device_config);
   if (!device_)
     throw InputError("embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
   rtc_scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(rtc_scene_, quality);
   // One Embree geometry per scene geometry, attached in order, so geomID and primID coincide.
   for (const Geometry& g : scene.geometries) {
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);

@@ -1,5 +1,5 @@
 // Intel Embree 3 as a side-by-side reference backend (never the default): the same scene, the same
-// rays, through rtcIntersect1/rtcOccluded1 at Embree's default build quality, or with --packets
+// rays, through rtcIntersect1/rtcOccluded1 at Embree's default build quality (or HIGH), or with --packets
 // through its packet API at its best: rtcIntersect16 per 4x4 pixel block (coherent), rtcOccluded16
 // for a block's shadow rays and for each hit's AO rays.
 #pragma once
@@ -17,8 +17,10 @@ namespace tracer {
 
 class EmbreeAccel {
  public:
-  // `device_config`: rtcNewDevice's configuration string (e.g. "isa=avx2"; null: Embree's choice).
-  explicit EmbreeAccel(const Scene& scene, CancelFlag cancel = nullptr, const char* device_config = nullptr);
+  // `device_config`: rtcNewDevice's configuration string (e.g. "isa=avx2"; null: Embree's choice);
+  // `quality`: the scene's build quality (MEDIUM, Embree's default; HIGH adds spatial splits).
+  explicit EmbreeAccel(const Scene& scene, CancelFlag cancel = nullptr, const char* device_config = nullptr,
+                       RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

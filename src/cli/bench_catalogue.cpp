@@ -47,6 +47,10 @@ const std::vector<Variant>& all_variants() {
        "Intel Embree 3, packets: rtcIntersect16 per 4x4 block, rtcOccluded16 for its shadow rays and for each hit's "
        "AO rays, TBB work stealing",
        false, true},
+      {"embree-high", AccelKind::EmbreeHigh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "Intel Embree 3 at its HIGH build quality (spatial splits), single rays, TBB work stealing", false},
+      {"embree-high-packets", AccelKind::EmbreeHigh, BvhSplit::Sah, BuildMode::Tasks, SchedKind::Tbb,
+       "Intel Embree 3 at its HIGH build quality, packets as embree-packets, TBB work stealing", false, true},
   };
   return v;
 }
@@ -152,8 +156,8 @@ std::vector<Variant> resolve_variants(const std::string& spec) {
     for (const Variant& v : all_variants()) {
       const bool group = item == "all" || (item == "study" && v.study) || (item == "ours" && !v.study);
       if (group || v.name == item) {
-        if (v.accel == AccelKind::Embree && !embree_available()) {
-          if (item == v.name) throw UsageError("--variants: 'embree' needs a build with Embree");
+        if (is_embree(v.accel) && !embree_available()) {
+          if (item == v.name) throw UsageError("--variants: '" + v.name + "' needs a build with Embree");
           continue;
         }
         out.push_back(v);

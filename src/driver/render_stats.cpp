@@ -74,10 +74,10 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
               str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              !j["packets"].get<bool>()         ? ""
-              : accel.kind == AccelKind::Bvh8   ? ", primary rays in 4x4 packets, AO rays in bundles"
-              : accel.kind == AccelKind::Embree ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
-                                                : ", AO rays in bundles");
+              !j["packets"].get<bool>()       ? ""
+              : accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles"
+              : is_embree(accel.kind)         ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
+                                              : ", AO rays in bundles");
   std::printf("memory       %.1f MiB accelerator, %.1f MiB peak resident (scene, accelerator, image)\n",
               double(j["accel_bytes"].get<size_t>()) / (1024.0 * 1024.0), j["peak_rss_mib"].get<double>());
   if (const std::optional<BvhStats> st = accel.bvh_stats()) {
