@@ -92,6 +92,57 @@ TEST(Render, SameRenderTwiceIsByteIdentical) {
   EXPECT_NE(a.rgb, c.rgb);
 }
 
+// --count renders through the counting kernels: the same image, and counts that are a function
+// of the rays alone (the same for every scheduler and thread count).
+TEST(Render, CountedTraversalChangesNoPixelAndCountsTheSameEverywhere) {
+  const Scene scene = make_cornell_box(200);
+  for (const Integrator integrator : {Integrator::Ao, Integrator::Path}) {
+    for (const bool packets : {true, false}) {
+      RenderSettings s;
+      s.width = s.height = 40;
+      s.integrator = integrator;
+      s.packets = packets && integrator == Integrator::Ao;
+      s.spp = integrator == Integrator::Path ? 4 : 1;
+      SCOPED_TRACE(std::string(name_of<Integrator>(kIntegratorNames, integrator)) + (s.packets ? " packets" : ""));
+      const Accelerator acc = build_accelerator(scene, AccelOptions{});
+      QueryCounts first;
+      std::vector<float> plain;
+      for (const auto& [kind, threads] : {std::pair{SchedKind::Seq, 1}, {SchedKind::Tbb, 2}, {SchedKind::Queue, 3}}) {
+        for (const bool counted : {false, true}) {
+          RenderSettings r = s;
+          r.count_traversal = counted;
+          Framebuffer fb(r.width, r.height);
+          RenderContext ctx{&scene, Camera(*scene.camera, r.width, r.height), r, &fb};
+          RenderControl control;
+          SchedOptions so;
+          so.kind = kind;
+          so.threads = threads;
+          ASSERT_TRUE(render_round(acc, ctx, sample_passes(r), so, control));
+          std::vector<float> sums;
+          for (size_t i = 0; i < fb.pixel_count(); ++i) {
+            for (int k = 0; k < 3; ++k) sums.push_back(fb.sums()[i][k]);
+          }
+          if (plain.empty()) plain = sums;
+          EXPECT_EQ(sums, plain);  // counting changes no pixel, nor does the scheduler
+          const QueryCounts c = control.traversal.load();
+          if (!counted) {
+            EXPECT_EQ(c.closest.rays + c.any.rays, 0u);  // off means off
+            continue;
+          }
+          const RayCounts rays = control.counts.load();
+          EXPECT_EQ(c.closest.rays, rays.primary + rays.secondary);
+          EXPECT_EQ(c.any.rays, rays.shadow + rays.ao);
+          EXPECT_GE(c.closest.nodes, c.closest.rays);  // every query visits the root
+          EXPECT_GT(c.any.packs, 0u);
+          if (first.closest.rays == 0) first = c;
+          EXPECT_EQ(c.closest, first.closest);
+          EXPECT_EQ(c.any, first.any);
+        }
+      }
+    }
+  }
+}
+
 // Renders `scene` (empty: the built-in box) at 96x96 with `flags` and requires the bytes of
 // tests/golden/`golden`.png, or with `min_psnr` a PSNR of at least that many dB; the PSNR is
 // printed on failure.

@@ -107,6 +107,37 @@ TEST(WideBvh, RaysStartingOnTrianglesAndAlongEdges) {
   EXPECT_GT(checked, 100u);
 }
 
+// The counters on a tree whose root holds one leaf of one triangle: a ray that hits it visits the
+// root, the pack and its triangle; one that misses every child box visits the root alone.
+TEST(WideBvh, CountersSayWhatTheTraversalVisited) {
+  const Scene scene = test::scene_of({Triangle{{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}}});
+  const WideBvh bvh(scene, BvhBuildOptions{});
+  Ray through;
+  through.org = {0, 0, 2};
+  through.dir = {0, 0, -1};
+  Ray beside = through;
+  beside.org = {5, 0, 2};
+  TraversalCounts closest, any;
+  Hit hit;
+  EXPECT_TRUE(bvh.intersect(through, hit, closest));
+  EXPECT_EQ(closest, (TraversalCounts{.rays = 1, .nodes = 1, .packs = 1, .triangles = 1}));
+  EXPECT_FALSE(bvh.intersect(beside, hit, closest));
+  EXPECT_EQ(closest, (TraversalCounts{.rays = 2, .nodes = 2, .packs = 1, .triangles = 1}));
+  EXPECT_TRUE(bvh.occluded(through, any));
+  EXPECT_FALSE(bvh.occluded(beside, any));
+  EXPECT_EQ(any, (TraversalCounts{.rays = 2, .nodes = 2, .packs = 1, .triangles = 1}));
+  // A bundle of both counts each ray's visits as the two rays alone do.
+  RayBundle bundle;
+  bundle.org = through.org;
+  bundle.set_direction(0, through.dir);
+  bundle.set_direction(1, Vec3{1, 0, 0});  // along the plane, above it: misses
+  TraversalCounts bundled;
+  EXPECT_EQ(bvh.occluded_bundle_from(bundle, 0, bundled) & 1u, 1u);
+  EXPECT_EQ(bundled.rays, 2u);
+  EXPECT_LE(bundled.nodes, 2u);
+  EXPECT_EQ(bundled.packs, 1u);
+}
+
 TEST(WideBvh, DegenerateInputs) {
   const Triangle t{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   for (const auto& tris : {std::vector<Triangle>{}, std::vector<Triangle>{t}, std::vector<Triangle>(50, t)}) {

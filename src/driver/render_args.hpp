@@ -65,6 +65,7 @@ struct RenderArgs {
   std::optional<int> threads;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;
+  bool count = false;  // --count: traversal counters in the statistics
   std::string stats_json;
 };
 

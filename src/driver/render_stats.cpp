@@ -22,7 +22,7 @@ double peak_rss_mib() {
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
-                            const RayCounts& rays, const LoadPhases* load_phases) {
+                            const RayCounts& rays, const LoadPhases* load_phases, const QueryCounts* traversal) {
   const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
   nlohmann::json j = {
       {"scene", scene.source},
@@ -57,6 +57,16 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
                            {"parse", load_phases->parse_ms},
                            {"textures", load_phases->textures_ms},
                            {"assembly", load_phases->assembly_ms}};
+  }
+  if (traversal) {
+    const auto per_ray = [](const TraversalCounts& c) {
+      const double n = c.rays > 0 ? double(c.rays) : 1.0;
+      return nlohmann::json{{"rays", c.rays},
+                            {"nodes_per_ray", double(c.nodes) / n},
+                            {"packs_per_ray", double(c.packs) / n},
+                            {"triangles_per_ray", double(c.triangles) / n}};
+    };
+    j["traversal"] = {{"closest_hit", per_ray(traversal->closest)}, {"any_hit", per_ray(traversal->any)}};
   }
   return j;
 }
@@ -102,6 +112,14 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("throughput   %10.2f Mrays/s", j["mrays_per_s"].get<double>());
   if (integrator == "path") std::printf(", %.3f Msamples/s", j["samples_per_s"].get<double>() * 1e-6);
   std::printf("\n");
+  if (j.contains("traversal")) {
+    for (const auto& [key, title] : {std::pair{"closest_hit", "closest hit"}, {"any_hit", "any hit"}}) {
+      const auto& t = j["traversal"][key];
+      std::printf("traversal    %-11s %6.2f nodes, %5.2f leaf packs, %6.2f triangles per ray (%llu rays)\n", title,
+                  t["nodes_per_ray"].get<double>(), t["packs_per_ray"].get<double>(),
+                  t["triangles_per_ray"].get<double>(), t["rays"].get<unsigned long long>());
+    }
+  }
 }
 
 void write_stats_json(const std::string& path, const nlohmann::json& j) {

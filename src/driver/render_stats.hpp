@@ -11,7 +11,8 @@ namespace tracer::driver {
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
-                            const RayCounts& rays, const LoadPhases* load_phases = nullptr);
+                            const RayCounts& rays, const LoadPhases* load_phases = nullptr,
+                            const QueryCounts* traversal = nullptr);
 
 // Prints `j` (from render_stats()) as the --stats text.
 void print_stats(const nlohmann::json& j, const Accelerator& accel);

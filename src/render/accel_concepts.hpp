@@ -5,6 +5,7 @@
 #include <concepts>
 #include <cstdint>
 
+#include "accel/traversal_counts.hpp"
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
 
@@ -37,6 +38,34 @@ bool occluded_leaving(const Accel& accel, const Ray& ray, uint32_t origin) {
 template <class A>
 concept OcclusionPacketAccelerator = requires(const A& a, const RayPacket& p) {
   { a.occluded_packet(p) } -> std::same_as<uint32_t>;
+};
+
+// Accelerators that count what their queries visit (the 8-wide BVH).
+template <class A>
+concept CountingAccelerator = requires(const A& a, const Ray& r, Hit& h, TraversalCounts& c) {
+  { a.intersect(r, h, c) } -> std::same_as<bool>;
+  { a.occluded(r, c) } -> std::same_as<bool>;
+};
+
+// A counting accelerator seen as an ordinary one (--count): each query goes to the counted
+// kernels, closest hits into counts->closest and any hits into counts->any. The integrators run
+// on it unchanged, so the image is the one the uncounted render makes.
+template <CountingAccelerator A>
+class Counted {
+ public:
+  Counted(const A& accel, QueryCounts& counts) : accel_(&accel), counts_(&counts) {}
+  bool intersect(const Ray& r, Hit& h) const { return accel_->intersect(r, h, counts_->closest); }
+  bool occluded(const Ray& r) const { return accel_->occluded(r, counts_->any); }
+  void intersect_packet(const RayPacket& p, Hit* h) const requires PacketAccelerator<A> {
+    accel_->intersect_packet(p, h, counts_->closest);
+  }
+  uint32_t occluded_bundle_from(const RayBundle& b, uint32_t origin) const requires BundleAccelerator<A> {
+    return accel_->occluded_bundle_from(b, origin, counts_->any);
+  }
+
+ private:
+  const A* accel_;
+  QueryCounts* counts_;
 };
 
 }  // namespace tracer

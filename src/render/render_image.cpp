@@ -1,6 +1,7 @@
 #include "render/render_image.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace tracer {
 
@@ -13,7 +14,7 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
         // same) with the cancel flag checked between them: a whole-row tile of the async and seq
         // schedulers or a --tile 4096 stops within moments of a Ctrl-C.
         constexpr int kPieceWidth = 64;
-        const RayCounts counts = accel.visit([&](const auto& a) {
+        const auto pieces = [&](const auto& a) {
           RayCounts sum;
           uint64_t pixels = 0;
           for (int y = tile.y0; y < tile.y1 && !control.cancelled(); y += kPacketEdge) {
@@ -25,6 +26,18 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
           }
           control.pixels_done.fetch_add(pixels * ctx.samples.count, std::memory_order_relaxed);
           return sum;
+        };
+        const RayCounts counts = accel.visit([&](const auto& a) {
+          using A = std::decay_t<decltype(a)>;
+          if constexpr (CountingAccelerator<A>) {
+            if (ctx.settings.count_traversal) {
+              QueryCounts traversal;
+              const RayCounts sum = pieces(Counted<A>(a, traversal));
+              control.traversal.add(traversal);
+              return sum;
+            }
+          }
+          return pieces(a);
         });
         control.counts.add(counts);
         control.rays_done.fetch_add(counts.total(), std::memory_order_relaxed);

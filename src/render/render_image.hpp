@@ -21,6 +21,7 @@ struct RenderControl {
   std::atomic<uint64_t> pixels_done{0};  // pixel samples, over all passes
   std::atomic<uint64_t> rays_done{0};
   AtomicRayCounts counts;
+  AtomicQueryCounts traversal;               // with settings.count_traversal, where the accelerator counts
   std::function<void(const Tile&)> on_tile;  // test hook, called once per rendered tile
   bool cancelled() const { return is_cancelled(cancel); }
 };

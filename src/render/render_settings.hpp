@@ -39,6 +39,9 @@ struct RenderSettings {
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
+  // Count the nodes, leaf packs and triangles each query visits (--count; accelerators that can:
+  // the 8-wide BVH): the same image, rendered through counting kernels.
+  bool count_traversal = false;
 };
 
 }  // namespace tracer

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "accel/bvh/bvh.hpp"
+#include "accel/traversal_counts.hpp"
 #include "math/ray_packet.hpp"
 
 namespace tracer {
@@ -55,6 +56,11 @@ class WideBvh {
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
+  // The same queries, counting what they visit into `counts` (--count).
+  bool intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const;
+  bool occluded(const Ray& ray, TraversalCounts& counts) const;
+  void intersect_packet(const RayPacket& rays, Hit* hits, TraversalCounts& counts) const;
+  uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin, TraversalCounts& counts) const;
   // Closest hits of the packet's active lanes, traversed together; hits[k] is exactly what
   // intersect(rays.ray(k), hits[k]) gives. Inactive lanes' hits are left untouched.
   void intersect_packet(const RayPacket& rays, Hit* hits) const;

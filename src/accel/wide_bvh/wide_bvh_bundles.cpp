@@ -53,8 +53,10 @@ HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t coun
   return found;
 }
 
-uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t /*origin*/) {
+template <class Count>
+uint32_t OccludedBundleWideT(const WideBvh& bvh, const RayBundle& rays, Count count) {
   const auto& nodes = bvh.nodes();
+  count.rays(uint32_t(std::popcount(rays.active)));
   if (nodes.empty() || rays.active == 0) return 0;
   const BundleState st(rays);
   // Rays that miss the tree's box are answered at once.
@@ -82,12 +84,15 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
     if (std::popcount(lanes) < kBundleMinLanes) {
       for (uint32_t bits = lanes; bits; bits &= bits - 1) {
         const int k = __builtin_ctz(bits);
-        if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f}))
+        if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f},
+                          count))
           found |= 1u << k;
       }
     } else if (e.count > 0) {
+      count.pack(uint32_t(std::popcount(lanes)), e.count);
       found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
     } else {
+      count.node(uint32_t(std::popcount(lanes)));
       const WideNode& n = nodes[e.child];
       for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
         if (n.child[c] == 0 && n.count[c] == 0) break;  // empty slots come last
@@ -103,6 +108,13 @@ uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t 
   return occluded;
 }
 
+uint32_t OccludedBundleWide(const WideBvh& bvh, const RayBundle& rays, uint32_t /*origin*/) {
+  return OccludedBundleWideT(bvh, rays, NoCount{});
+}
+uint32_t OccludedBundleWideCounted(const WideBvh& bvh, const RayBundle& rays, TraversalCounts* counts) {
+  return OccludedBundleWideT(bvh, rays, CountInto{counts});
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace tracer
 HWY_AFTER_NAMESPACE();
@@ -111,9 +123,13 @@ HWY_AFTER_NAMESPACE();
 namespace tracer {
 
 HWY_EXPORT(OccludedBundleWide);
+HWY_EXPORT(OccludedBundleWideCounted);
 
 uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t origin) const {
   return HWY_DYNAMIC_DISPATCH(OccludedBundleWide)(*this, rays, origin);
+}
+uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t /*origin*/, TraversalCounts& counts) const {
+  return HWY_DYNAMIC_DISPATCH(OccludedBundleWideCounted)(*this, rays, &counts);
 }
 
 }  // namespace tracer

@@ -247,8 +247,9 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
 }
 
 // Any hit for one ray below `start` (a node, or a leaf pack when start.count > 0).
+template <class Count>
 HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar,
-                              StackEntry start) {
+                              StackEntry start, Count count) {
   const WideNode* nodes = bvh.nodes().data();
   const Triangle* tris = bvh.scene().triangles.data();
   const TrianglePack* packs = bvh.packs().data();
@@ -264,6 +265,7 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
       // Any hit ends the query, so distance does not order the children: the last slot (the
       // smallest subtree, see wide_bvh_build.cpp) is entered first, the others popped from the
       // last down.
+      count.node(1);
       const WideNode& n = nodes[cur.child];
       uint32_t bits = TestChildren(n, node_ray, tnear, tfar, t);
       if (bits) {
@@ -275,8 +277,9 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
         cur = {n.child[c], n.count[c], 0.0f};
         continue;
       }
-    } else if (IntersectPack(packs[cur.child], pack_ray, tris, tnear, tfar, tt, uu, vv)) {
-      return true;
+    } else {
+      count.pack(1, cur.count);
+      if (IntersectPack(packs[cur.child], pack_ray, tris, tnear, tfar, tt, uu, vv)) return true;
     }
     if (sp == 0) return false;
     cur = stack[--sp];
@@ -284,9 +287,11 @@ HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RaySh
 }
 
 // Any hit for one ray, from the root.
-HWY_INLINE bool OccludedFromRoot(const WideBvh& bvh, const Ray& ray) {
+template <class Count>
+HWY_INLINE bool OccludedFromRoot(const WideBvh& bvh, const Ray& ray, Count count) {
+  count.rays(1);
   if (bvh.nodes().empty()) return false;
-  return OccludedBelow(bvh, WideRay(ray), RayShear(ray), ray.tnear, ray.tfar, StackEntry{0, 0, ray.tnear});
+  return OccludedBelow(bvh, WideRay(ray), RayShear(ray), ray.tnear, ray.tfar, StackEntry{0, 0, ray.tnear}, count);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -11,6 +11,7 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include <bit>
 #include <cmath>
 
 #include "accel/kernels/simd_lanes-inl.h"
@@ -133,7 +134,8 @@ struct PacketEntry {
   float t;                // their smallest entry distance
 };
 
-void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
+template <class Count>
+void IntersectPacketWideT(const WideBvh& bvh, const RayPacket& rays, Hit* hits, Count count, TraversalCounts* counts) {
   const uint32_t active = rays.active & ((1u << kPacketSize) - 1u);
   for (uint32_t bits = active; bits; bits &= bits - 1) {
     const int lane = __builtin_ctz(bits);
@@ -182,10 +184,14 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
   if (!shared_axes) {
     for (uint32_t bits = active; bits; bits &= bits - 1) {
       const int lane = __builtin_ctz(bits);
-      bvh.intersect(rays.ray(lane), hits[lane]);
+      if (counts)
+        bvh.intersect(rays.ray(lane), hits[lane], *counts);
+      else
+        bvh.intersect(rays.ray(lane), hits[lane]);
     }
     return;
   }
+  count.rays(uint32_t(std::popcount(active)));
   const float* org[3] = {st.ox, st.oy, st.oz};
   st.okx = org[st.kx];
   st.oky = org[st.ky];
@@ -199,6 +205,7 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
   PacketEntry cur{0, 0, active, 0.0f};
   for (;;) {
     if (cur.count == 0) {
+      count.node(uint32_t(std::popcount(cur.lanes)));
       const WideNode& n = nodes[cur.child];
       PacketEntry hit[kWideWidth];
       int k = 0;
@@ -222,6 +229,7 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
         continue;
       }
     } else {
+      count.pack(uint32_t(std::popcount(cur.lanes)), cur.count);
       const TrianglePack& p = packs[cur.child];
       for (uint32_t k = 0; k < cur.count; ++k) IntersectTrianglePacket(p, int(k), tris, st, cur.lanes);
     }
@@ -239,6 +247,13 @@ void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
   }
 }
 
+void IntersectPacketWide(const WideBvh& bvh, const RayPacket& rays, Hit* hits) {
+  IntersectPacketWideT(bvh, rays, hits, NoCount{}, nullptr);
+}
+void IntersectPacketWideCounted(const WideBvh& bvh, const RayPacket& rays, Hit* hits, TraversalCounts* counts) {
+  IntersectPacketWideT(bvh, rays, hits, CountInto{counts}, counts);
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace tracer
 HWY_AFTER_NAMESPACE();
@@ -247,9 +262,13 @@ HWY_AFTER_NAMESPACE();
 namespace tracer {
 
 HWY_EXPORT(IntersectPacketWide);
+HWY_EXPORT(IntersectPacketWideCounted);
 
 void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits) const {
   HWY_DYNAMIC_DISPATCH(IntersectPacketWide)(*this, rays, hits);
+}
+void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits, TraversalCounts& counts) const {
+  HWY_DYNAMIC_DISPATCH(IntersectPacketWideCounted)(*this, rays, hits, &counts);
 }
 
 }  // namespace tracer

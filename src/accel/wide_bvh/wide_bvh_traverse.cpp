@@ -12,7 +12,9 @@ namespace tracer {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
+template <class Count>
+bool IntersectWideT(const WideBvh& bvh, const Ray& ray, Hit& hit, Count count) {
+  count.rays(1);
   hit = Hit{};
   hit.t = ray.tfar;
   const auto& nodes = bvh.nodes();
@@ -28,9 +30,11 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   StackEntry cur{0, 0, ray.tnear};
   for (;;) {
     if (cur.count == 0) {
+      count.node(1);
       const WideNode& n = nodes[cur.child];
       if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
     } else {
+      count.pack(1, cur.count);
       ClosestInPack(packs[cur.child], shear, tris, ray.tnear, hit);
     }
     // Pop, skipping entries now beyond the closest hit (<=: ties still count).
@@ -41,7 +45,14 @@ bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) {
   }
 }
 
-bool OccludedWide(const WideBvh& bvh, const Ray& ray) { return OccludedFromRoot(bvh, ray); }
+bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) { return IntersectWideT(bvh, ray, hit, NoCount{}); }
+bool IntersectWideCounted(const WideBvh& bvh, const Ray& ray, Hit& hit, TraversalCounts* counts) {
+  return IntersectWideT(bvh, ray, hit, CountInto{counts});
+}
+bool OccludedWide(const WideBvh& bvh, const Ray& ray) { return OccludedFromRoot(bvh, ray, NoCount{}); }
+bool OccludedWideCounted(const WideBvh& bvh, const Ray& ray, TraversalCounts* counts) {
+  return OccludedFromRoot(bvh, ray, CountInto{counts});
+}
 
 }  // namespace HWY_NAMESPACE
 }  // namespace tracer
@@ -51,12 +62,20 @@ HWY_AFTER_NAMESPACE();
 namespace tracer {
 
 HWY_EXPORT(IntersectWide);
+HWY_EXPORT(IntersectWideCounted);
 HWY_EXPORT(OccludedWide);
+HWY_EXPORT(OccludedWideCounted);
 
 // One table-indexed call per ray (Highway's dynamic dispatch), never per node: the kernels above
 // inline the whole traversal.
 bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectWide)(*this, ray, hit); }
 bool WideBvh::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedWide)(*this, ray); }
+bool WideBvh::intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const {
+  return HWY_DYNAMIC_DISPATCH(IntersectWideCounted)(*this, ray, hit, &counts);
+}
+bool WideBvh::occluded(const Ray& ray, TraversalCounts& counts) const {
+  return HWY_DYNAMIC_DISPATCH(OccludedWideCounted)(*this, ray, &counts);
+}
 
 }  // namespace tracer
 #endif  // HWY_ONCE
