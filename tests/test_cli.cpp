@@ -87,6 +87,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --fov 0", 2, "--fov: must be at least 0.001"},
       {"render --fov 1e-30", 2, "--fov: must be at least 0.001"},
       {"render --accel kdtree", 2, "--accel: unknown accelerator 'kdtree'"},
+      {"render --aperture -0.5", 2, "--aperture: must be at least 0"},
+      {"render --focus-distance 0", 2, "--focus-distance: must be above 0"},
       {"render --count --accel bvh", 2, "--count: only the 8-wide BVH counts its traversal"},
       {"render --sched openmp", 2, "--sched: unknown scheduler 'openmp'"},
       {"render --bvh-split middle", 2, "--bvh-split: unknown split 'middle'"},

@@ -343,11 +343,7 @@ TEST(Exr, TheCliWritesTheRadianceThePngToneMaps) {
   std::filesystem::remove_all(dir);
 }
 
-// Every byte of a file (the images compared below).
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using test::read_bytes;
 
 TEST(AntiAliasing, EveryIntegratorTakesSamplesPerPixelDeterministically) {
   const std::string dir = test::temp_dir();

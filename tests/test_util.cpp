@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "math/rng.hpp"
 
@@ -77,6 +79,11 @@ double psnr(const Image8& a, const Image8& b) {
   }
   mse /= double(a.rgb.size());
   return mse == 0.0 ? 1e9 : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 std::string temp_dir() {

@@ -45,5 +45,7 @@ double psnr(const Image8& a, const Image8& b);
 
 // A fresh temporary directory for one test.
 std::string temp_dir();
+// Every byte of a file (images compared byte for byte).
+std::string read_bytes(const std::string& path);
 
 }  // namespace tracer::test

@@ -80,6 +80,10 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--look,-l", a.look, "point the camera looks at, x,y,z");
   app.add_option("--up", a.up, "camera up vector x,y,z (default 0,1,0)");
   app.add_option("--fov", a.fov, "vertical field of view in degrees (default 53.13)");
+  app.add_option("--aperture", a.aperture,
+                 "depth of field: the radius of a thin lens, in scene units (default 0: a pinhole, all sharp)");
+  app.add_option("--focus-distance", a.focus_distance,
+                 "with --aperture: the distance of the plane in focus along the view (default: the look-at point's)");
   app.add_option("--integrator", a.integrator,
                  "what a pixel is made of: ao (the study's workload: direct light, ambient occlusion, every surface "
                  "diffuse), whitted (mirrors and glass from the MTL, hard shadows) or path (path tracing: every "
@@ -164,6 +168,8 @@ void validate(const RenderArgs& a) {
   }
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, LowEnd::Open);
   if (a.fov) check_range_real("--fov", *a.fov, 1e-3, 179.0);
+  if (a.aperture) check_range_real("--aperture", *a.aperture, 0.0, 1e6);
+  if (a.focus_distance) check_range_real("--focus-distance", *a.focus_distance, 0.0, 1e12, LowEnd::Open);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
   check_range_real("--exposure", s.exposure, 0.0, 1e6, LowEnd::Open);
   check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);

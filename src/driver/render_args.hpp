@@ -43,6 +43,8 @@ struct RenderArgs {
   SchedOptions sched;       // --tile --block
   std::string eye, look, up;
   std::optional<double> fov;
+  std::optional<double> aperture;        // --aperture: the lens radius, in scene units
+  std::optional<double> focus_distance;  // --focus-distance: default the look-at point's
   std::optional<double> ao_distance;
   std::optional<std::string> accel;          // empty: the library's default (scalar bvh with --simd off)
   bool packets = false, no_packets = false;  // neither: packets where the accelerator can

@@ -142,6 +142,8 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
                      ", is below what a float camera resolves); give --eye and --look");
   }
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
+  if (a.aperture) spec.lens_radius = float(*a.aperture);
+  if (a.focus_distance) spec.focus_distance = float(*a.focus_distance);
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
   return spec;
 }

@@ -36,6 +36,23 @@ inline Vec3 cosine_hemisphere(float u1, float u2) {
   return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1))};
 }
 
+// A uniform point on the unit disk by Shirley and Chiu's concentric map: the square's strata stay
+// compact on the disk, so stratified numbers give a stratified lens.
+inline Vec2 concentric_disk(float u1, float u2) {
+  const float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
+  constexpr float kQuarterPi = std::numbers::pi_v<float> / 4.0f;
+  float r, phi;
+  if (std::fabs(a) > std::fabs(b)) {
+    r = a;
+    phi = kQuarterPi * (b / a);
+  } else {
+    r = b;
+    phi = 2.0f * kQuarterPi - kQuarterPi * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
+}
+
 // Uniform barycentrics (b1, b2) on a triangle: the square-root warp.
 inline void uniform_triangle(float u1, float u2, float& b1, float& b2) {
   const float su = std::sqrt(u1);

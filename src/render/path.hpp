@@ -29,6 +29,9 @@ constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
 constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
 constexpr uint32_t roulette_set(int depth) { return 3 + 3 * uint32_t(depth); }
 inline constexpr int kRouletteDepth = 3;  // bounces kept unconditionally
+// The lens point of a thin-lens camera: a set of its own, beyond every bounce's (--max-depth is at
+// most 64), drawn only when the camera has a lens, so a pinhole's samples are unchanged.
+inline constexpr uint32_t kLensSet = 1u << 16;
 
 // What the camera ray hits first, for the --aov layers: its albedo (the diffuse colour, plus the
 // specular colour of glossy materials, 1 for mirrors and glass, as Intel's denoiser takes it) and
@@ -169,7 +172,13 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const PixelSampler sampler(pixel, k, s.seed);
         const std::array<float, 2> pu = sampler.get<2>(kPixelSet);
-        const Ray ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1]);
+        Ray ray;
+        if (ctx.camera.thin_lens()) {
+          const std::array<float, 2> lens = sampler.get<2>(kLensSet);
+          ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1], lens[0], lens[1]);
+        } else {
+          ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1]);
+        }
         ++counts.primary;
         FirstHit first;
         const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr);

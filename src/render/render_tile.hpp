@@ -8,9 +8,9 @@
 
 namespace tracer {
 
-// ao and whitted with more than one sample per pixel: each sample a ray through a point of the
-// pixel drawn from its own stream (pixel, sample), as path tracing's camera rays are, so passes,
-// tiles and threads add up to the same image.
+// ao and whitted with more than one sample per pixel, or through a lens: each sample a ray through
+// a point of the pixel (and of the lens) drawn from its own stream (pixel, sample), as path
+// tracing's camera rays are, so passes, tiles and threads add up to the same image.
 template <class Accel>
 void antialiased_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, RayCounts& counts) {
   const RenderSettings& s = ctx.settings;
@@ -21,7 +21,9 @@ void antialiased_tile(const Accel& accel, const RenderContext& ctx, const Tile& 
       Vec3 sum{0.0f};
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const SampleRng rng(pixel, k, s.seed ^ kJitterStream);
-        const Ray ray = ctx.camera.ray_through(float(x) + rng.draw(0), float(y) + rng.draw(1));
+        const Ray ray = ctx.camera.thin_lens() ? ctx.camera.ray_through(float(x) + rng.draw(0), float(y) + rng.draw(1),
+                                                                        rng.draw(2), rng.draw(3))
+                                               : ctx.camera.ray_through(float(x) + rng.draw(0), float(y) + rng.draw(1));
         ++counts.primary;
         if (s.integrator == Integrator::Whitted) {
           sum += whitted_radiance(accel, ctx, ray, 0, counts);
@@ -43,7 +45,7 @@ RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& 
     path_tile(accel, ctx, tile, counts);
     return counts;
   }
-  if (ctx.settings.spp > 1) {
+  if (ctx.settings.spp > 1 || ctx.camera.thin_lens()) {
     antialiased_tile(accel, ctx, tile, counts);
     return counts;
   }

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "math/ray.hpp"
+#include "math/sampling.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -44,6 +45,10 @@ class Camera {
     const Vec3 forward = normalize(spec.look - spec.eye);
     const Vec3 right = normalize(cross(forward, spec.up));
     const Vec3 up = cross(right, forward);
+    lens_right_ = right * spec.lens_radius;
+    lens_up_ = up * spec.lens_radius;
+    lens_ = spec.lens_radius > 0.0f;
+    focus_ = spec.focus_distance > 0.0f ? spec.focus_distance : length(spec.look - spec.eye);
     const float tan_half = std::tan(spec.fov_degrees * float(std::numbers::pi) / 360.0f);
     const float aspect = float(width) / float(height);
     // Pixel (x, y) maps to forward + (2*(x+0.5)/w - 1)*du + (1 - 2*(y+0.5)/h)*dv.
@@ -69,8 +74,27 @@ class Camera {
     return r;
   }
 
+  // Whether the camera has a lens (depth of field): then each sample takes a lens point.
+  bool thin_lens() const { return lens_; }
+  // The ray through image position (px, py) leaving the lens at the point the two numbers
+  // (u1, u2) in [0, 1) give (concentric_disk): it passes through the pinhole ray's point on the
+  // plane in focus, so that plane stays sharp and a point at depth z blurs into a circle of radius
+  // lens_radius * |1 - z / focus_distance| there. Without a lens, the pinhole ray.
+  Ray ray_through(float px, float py, float u1, float u2) const {
+    Ray r = ray_through(px, py);
+    if (!lens_) return r;
+    const Vec3 in_focus = eye_ + r.dir * (focus_ / dot(r.dir, forward_));
+    const Vec2 d = concentric_disk(u1, u2);
+    r.org = eye_ + lens_right_ * d.x + lens_up_ * d.y;
+    r.dir = normalize(in_focus - r.org);
+    return r;
+  }
+
  private:
   Vec3 eye_, forward_, du_, dv_;
+  Vec3 lens_right_{0.0f}, lens_up_{0.0f};  // the lens's axes, times its radius
+  float focus_ = 1.0f;                     // distance of the plane in focus along forward_
+  bool lens_ = false;
   float inv_w_ = 1.0f, inv_h_ = 1.0f;
 };
 

@@ -87,6 +87,10 @@ struct Geometry {
 struct CameraSpec {
   Vec3 eye, look, up{0.0f, 1.0f, 0.0f};
   float fov_degrees = 0.0f;
+  // A thin lens (depth of field): its radius in scene units (0: a pinhole, everything sharp) and
+  // the distance along the view direction of the plane in focus (0: the look-at point's).
+  float lens_radius = 0.0f;
+  float focus_distance = 0.0f;
 };
 
 struct Scene {
