@@ -45,7 +45,7 @@ TEST(Camera, ThePlaneInFocusStaysSharp) {
   const float focus = 2.5f;
   const Camera cam(lens_spec(0.2f, focus), kSide, kSide);
   ASSERT_TRUE(cam.thin_lens());
-  for (const auto [px, py] : {std::pair{32.0f, 32.0f}, {3.5f, 60.25f}, {63.0f, 0.5f}}) {
+  for (const auto& [px, py] : {std::pair{32.0f, 32.0f}, {3.5f, 60.25f}, {63.0f, 0.5f}}) {
     const Vec3 sharp = at_depth(cam.ray_through(px, py), focus);
     for (int i = 0; i < 8; ++i) {
       for (int j = 0; j < 8; ++j) {
@@ -65,7 +65,7 @@ TEST(Camera, BlurCircleFollowsTheThinLensFormula) {
   const float radius = 0.15f, focus = 2.0f;
   const Camera cam(lens_spec(radius, focus), kSide, kSide);
   for (const float z : {0.5f, 1.0f, 3.0f, 6.0f}) {
-    for (const auto [u1, u2] : {std::pair{1.0f, 0.5f}, {0.0f, 0.5f}, {0.5f, 1.0f}, {0.5f, 0.0f}}) {
+    for (const auto& [u1, u2] : {std::pair{1.0f, 0.5f}, {0.0f, 0.5f}, {0.5f, 1.0f}, {0.5f, 0.0f}}) {
       const Ray r = cam.ray_through(32.0f, 32.0f, u1, u2);
       const Vec3 p = at_depth(r, z);
       const float off_axis = std::hypot(p.x, p.y - 1.0f);
