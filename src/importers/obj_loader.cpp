@@ -17,6 +17,7 @@
 #include "base/text.hpp"
 #include "importers/mtl_parser.hpp"
 #include "importers/obj_parser.hpp"
+#include "importers/warning_log.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -142,50 +143,6 @@ std::vector<std::vector<std::string>> mtllib_statements(std::string_view text) {
   }
   return statements;
 }
-
-// Groups warnings by kind (the text with its quoted names and numbers left out), so 80,000
-// undefined material names make one line with a count and the first place, not 80,000 lines.
-class WarningLog {
- public:
-  void add(const std::string& message) {
-    const std::string key = kind_of(message);
-    auto [it, inserted] = index_.try_emplace(key, entries_.size());
-    if (inserted) entries_.push_back({message, 0});
-    ++entries_[it->second].count;
-  }
-  void flush(const std::string& name, const WarningSink& sink) const {
-    for (const Entry& e : entries_) {
-      std::string line = name + ": " + escaped(e.first);
-      if (e.count > 1) line += " (" + std::to_string(e.count) + " times; the first shown)";
-      sink(line);
-    }
-  }
-
- private:
-  static std::string kind_of(std::string_view message) {
-    std::string key;
-    char quote = 0;
-    for (char c : message) {
-      if (quote) {
-        if (c == quote) quote = 0, key += c;
-        continue;
-      }
-      if (c == '\'' || c == '"') quote = c;
-      if (c >= '0' && c <= '9') {
-        if (key.empty() || key.back() != '#') key += '#';
-        continue;
-      }
-      key += c;
-    }
-    return key;
-  }
-  struct Entry {
-    std::string first;
-    size_t count;
-  };
-  std::vector<Entry> entries_;
-  std::unordered_map<std::string, size_t> index_;
-};
 
 Material to_material(const MtlMaterial& m, const std::string& name) {
   Material mat;
@@ -400,8 +357,6 @@ void add_materials(Scene& scene, const Layout& layout, MaterialTextures textures
   }
   if (layout.uses_default) scene.materials.push_back(Material{});
 }
-
-void default_warning(const std::string& message) { std::cerr << "tracer: warning: " << message << "\n"; }
 
 Scene load(std::string_view text, const std::string& name, const fs::path& base_dir, MtlSource mtl,
            const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits, LoadPhases* phases) {

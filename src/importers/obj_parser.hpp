@@ -16,17 +16,11 @@
 #include <vector>
 
 #include "base/errors.hpp"
+#include "importers/load_limits.hpp"
 #include "math/vec.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
-
-// body(i) for every i in [0, count), possibly in parallel. The loader knows nothing of threads; the
-// caller hands it an executor's loop.
-using ForEach = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
-inline void sequential_for_each(size_t count, const std::function<void(size_t)>& body) {
-  for (size_t i = 0; i < count; ++i) body(i);
-}
 
 // A statement that sets state for the faces after it.
 struct ObjStatement {

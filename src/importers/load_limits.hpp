@@ -1,0 +1,36 @@
+// What a scene load may read and take, and where its time went: shared by every importer.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include "base/read_input.hpp"
+#include "scene/texture.hpp"
+
+namespace tracer {
+
+// body(i) for every i in [0, count), possibly in parallel. The loader knows nothing of threads; the
+// caller hands it an executor's loop.
+using ForEach = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
+inline void sequential_for_each(size_t count, const std::function<void(size_t)>& body) {
+  for (size_t i = 0; i < count; ++i) body(i);
+}
+
+// What a load may read (the scene file's size, MTL files 64 MiB each, the textures' texels), and
+// the loop it reads and decodes textures with.
+struct LoadLimits {
+  uint64_t max_obj_bytes = kDefaultMaxInputBytes;
+  TextureLimits textures;
+  ForEach for_each = sequential_for_each;
+  size_t chunk_bytes = 0;     // the OBJ parser's chunk size; 0: from the file's size
+  bool read_textures = true;  // false: no map_Kd file is read, materials use Kd (geometry-only loads)
+};
+
+// Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its
+// MTL, reading and decoding the textures, and assembling the scene's arrays.
+struct LoadPhases {
+  double read_ms = 0.0, parse_ms = 0.0, textures_ms = 0.0, assembly_ms = 0.0;
+};
+
+}  // namespace tracer
