@@ -16,14 +16,18 @@ inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
   return {c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, c[0].y * w + c[1].y * hit.u + c[2].y * hit.v};
 }
 
-// The shading normal `ns` moved by the material's bump map, as pbrt's bump mapping does: the
-// surface displaced along ns by bump_multiplier * height(u, v) in scene units, whose tangents are
-// dp/du + ns dh/du and dp/dv + ns dh/dv (dp/du, dp/dv from the triangle's positions and texture
-// coordinates; dh/du, dh/dv by central differences one texel wide), the normal their cross
-// product on ns's side. A normal that would face away from the viewer `wo` (where the BSDF would
-// return black: the fringes of shading normals) is tilted back until it faces it, just.
+// The shading normal `ns` moved by the material's normal map or bump map. A normal map (glTF's
+// normalTexture) gives the normal in the frame of the tangent dp/du made perpendicular to ns,
+// the bitangent on dp/dv's side and ns (per-triangle tangents, as glTF prescribes where a mesh
+// gives none). A bump map, as pbrt's bump mapping does: the surface displaced along ns by
+// bump_multiplier * height(u, v) in scene units, whose tangents are dp/du + ns dh/du and
+// dp/dv + ns dh/dv (dh/du, dh/dv by central differences one texel wide), the normal their cross
+// product on ns's side. dp/du, dp/dv come from the triangle's positions and texture coordinates.
+// A normal that would face away from the viewer `wo` (where the BSDF would return black: the
+// fringes of shading normals) is tilted back until it faces it, just.
 inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& mat, Vec3 ns, Vec3 wo) {
-  if (mat.bump_texture == kInvalidIndex || scene.corner_uvs.empty()) return ns;
+  const bool normal_map = mat.normal_texture != kInvalidIndex;
+  if ((!normal_map && mat.bump_texture == kInvalidIndex) || scene.corner_uvs.empty()) return ns;
   const Triangle& tri = scene.triangles[hit.tri];
   const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float du1 = c[1].x - c[0].x, dv1 = c[1].y - c[0].y, du2 = c[2].x - c[0].x, dv2 = c[2].y - c[0].y;
@@ -31,12 +35,23 @@ inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& ma
   if (!(std::fabs(det) > 1e-20f)) return ns;  // degenerate texture coordinates: no tangents
   const Vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
   const Vec3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0f / det), dpdv = (e2 * du1 - e1 * du2) * (1.0f / det);
-  const Texture& t = scene.textures[mat.bump_texture];
   const auto [u, v] = hit_uv(c, hit);
-  const float hu = 0.5f / float(t.width()), hv = 0.5f / float(t.height());
-  const float dhdu = (t.height(u + hu, v) - t.height(u - hu, v)) / (2.0f * hu) * mat.bump_multiplier;
-  const float dhdv = (t.height(u, v + hv) - t.height(u, v - hv)) / (2.0f * hv) * mat.bump_multiplier;
-  Vec3 n = cross(dpdu + ns * dhdu, dpdv + ns * dhdv);
+  Vec3 n;
+  if (normal_map) {
+    const Vec3 t_raw = dpdu - ns * dot(ns, dpdu);
+    const float t_len = length(t_raw);
+    if (!(t_len > 0.0f) || !std::isfinite(t_len)) return ns;
+    const Vec3 t = t_raw / t_len;
+    const Vec3 b = dot(cross(ns, t), dpdv) < 0.0f ? -cross(ns, t) : cross(ns, t);
+    const Vec3 m = scene.textures[mat.normal_texture].data(u, v) * 2.0f - Vec3{1.0f};
+    n = t * (m.x * mat.normal_scale) + b * (m.y * mat.normal_scale) + ns * m.z;
+  } else {
+    const Texture& tex = scene.textures[mat.bump_texture];
+    const float hu = 0.5f / float(tex.width()), hv = 0.5f / float(tex.height());
+    const float dhdu = (tex.height(u + hu, v) - tex.height(u - hu, v)) / (2.0f * hu) * mat.bump_multiplier;
+    const float dhdv = (tex.height(u, v + hv) - tex.height(u, v - hv)) / (2.0f * hv) * mat.bump_multiplier;
+    n = cross(dpdu + ns * dhdu, dpdv + ns * dhdv);
+  }
   const float len = length(n);
   if (!(len > 0.0f) || !std::isfinite(len)) return ns;
   n = n / len;

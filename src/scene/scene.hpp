@@ -56,6 +56,10 @@ struct Material {
   // in [0, 1] times bump_multiplier (-bm) displace the surface along its normal, in scene units.
   uint32_t bump_texture = kInvalidIndex;
   float bump_multiplier = 1.0f;
+  // glTF's normalTexture: a tangent-space normal map (an index into Scene::textures, or
+  // kInvalidIndex; its bytes as data, x along +u, y along +v), its x and y scaled by normal_scale.
+  uint32_t normal_texture = kInvalidIndex;
+  float normal_scale = 1.0f;
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
   // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.

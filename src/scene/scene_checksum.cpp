@@ -50,6 +50,10 @@ uint64_t scene_checksum(const Scene& scene) {
     h.value(m.diffuse_texture);
     h.value(m.bump_texture);
     h.value(m.bump_multiplier);
+    if (m.normal_texture != kInvalidIndex) {  // glTF's; OBJ scenes keep the checksums they had
+      h.value(m.normal_texture);
+      h.value(m.normal_scale);
+    }
   }
   h.value(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {

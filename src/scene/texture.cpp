@@ -124,6 +124,25 @@ float Texture::height(float u, float v) const {
   });
 }
 
+Texture Texture::tinted(Vec3 factor) const {
+  std::vector<uint8_t> out(srgb_.size());
+  const float f[3] = {factor.x, factor.y, factor.z};
+  for (size_t i = 0; i < out.size(); ++i) {
+    const float linear = std::clamp(kSrgbToLinear[srgb_[i]] * f[i % 3], 0.0f, 1.0f);
+    out[i] = kLinearToSrgb[size_t(std::lround(linear * 4096.0f))];
+  }
+  return Texture(width_, height_, std::move(out));
+}
+
+Vec3 Texture::data(float u, float v) const {
+  if (width_ == 0 || height_ == 0) return Vec3{0.0f};
+  const Footprint f = footprint(u, v, width_, height_);
+  return blend(f, [&](int x, int y) {
+    const uint8_t* p = &srgb_[3 * (size_t(y) * size_t(width_) + size_t(x))];
+    return Vec3{float(p[0]), float(p[1]), float(p[2])} * (1.0f / 255.0f);
+  });
+}
+
 Vec3 Texture::bilinear_at(const Level& level, float u, float v) const {
   const Footprint f = footprint(u, v, level.width, level.height);
   const auto& lut = kSrgbToLinear;
@@ -161,14 +180,20 @@ std::string stb_reason() {
 }  // namespace
 
 EncodedTexture read_texture(const fs::path& path, const TextureLimits& limits, CancelFlag cancel) {
-  EncodedTexture t;
-  t.name = path.string();
+  const std::string name = path.string();
   struct stat st {};
-  if (::stat(t.name.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-    throw InputError(t.name + ": not a regular file" + (S_ISFIFO(st.st_mode) ? " (a FIFO)" : ""));
+  if (::stat(name.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw InputError(name + ": not a regular file" + (S_ISFIFO(st.st_mode) ? " (a FIFO)" : ""));
   }
   // The encoded file is far smaller than its texels; a file this large is no texture.
-  t.bytes = read_input(t.name, cancel, limits.max_texels * 3 + (uint64_t(64) << 20));
+  std::string bytes = read_input(name, cancel, limits.max_texels * 3 + (uint64_t(64) << 20));
+  return encoded_texture(name, std::move(bytes), limits);
+}
+
+EncodedTexture encoded_texture(std::string name, std::string bytes, const TextureLimits& limits) {
+  EncodedTexture t;
+  t.name = std::move(name);
+  t.bytes = std::move(bytes);
   if (t.bytes.size() > size_t(std::numeric_limits<int>::max())) throw InputError(t.name + ": too large to decode");
   int channels = 0;
   if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(t.bytes.data()), int(t.bytes.size()), &t.width, &t.height,

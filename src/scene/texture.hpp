@@ -33,6 +33,11 @@ class Texture {
   // A bump map's height in [0, 1] at (u, v): the stored bytes as data (no sRGB decoding), the
   // mean of the channels, filtered bilinearly with repeat as bilinear() is.
   float height(float u, float v) const;
+  // The texture with each texel's linear colour times `factor` (clamped to 1): glTF's
+  // baseColorFactor folded into its baseColorTexture.
+  Texture tinted(Vec3 factor) const;
+  // The stored bytes as data in [0, 1] (a normal map's), filtered bilinearly with repeat.
+  Vec3 data(float u, float v) const;
   // The texels as stored: 8-bit sRGB, RGB, rows from the top.
   const std::vector<uint8_t>& srgb() const { return srgb_; }
 
@@ -76,6 +81,8 @@ struct EncodedTexture {
 // Cancelled when `cancel` is set while reading.
 EncodedTexture read_texture(const std::filesystem::path& path, const TextureLimits& limits = {},
                             CancelFlag cancel = nullptr);
+// The same for bytes already in memory (an image inside a glTF buffer); `name` names it in errors.
+EncodedTexture encoded_texture(std::string name, std::string bytes, const TextureLimits& limits = {});
 // Decodes what read_texture() read; throws InputError naming the file.
 Texture decode_texture(const EncodedTexture& encoded);
 // Both.
