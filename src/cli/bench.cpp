@@ -17,7 +17,7 @@
 #include "driver/render_args.hpp"
 #include "driver/render_options.hpp"
 #include "driver/scene_setup.hpp"
-#include "importers/obj_loader.hpp"
+#include "importers/scene_file.hpp"
 #include "io/image_io.hpp"
 #include "parallel/thread_count.hpp"
 #include "scene/builtin.hpp"
@@ -104,7 +104,7 @@ int run_bench(const BenchArgs& a) {
       duration_text(double(total_cells) * a.max_seconds).c_str());
   for (const SceneEntry& se : scenes) {
     const auto t_load = Clock::now();
-    Scene scene = se.path.empty() ? make_cornell_box(0) : load_obj(se.path, [](const std::string&) {});
+    Scene scene = se.path.empty() ? make_cornell_box(0) : load_scene_file(se.path, [](const std::string&) {});
     for (const auto& [out, flag] : outputs) {
       if (!out->empty()) check_output(*out, flag);
     }

@@ -13,7 +13,7 @@
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
 #include "driver/render_options.hpp"
-#include "importers/obj_loader.hpp"
+#include "importers/scene_file.hpp"
 #include "io/environment_io.hpp"
 #include "io/image_io.hpp"
 #include "parallel/executor.hpp"
@@ -48,7 +48,8 @@ CLI::Option* whole_option(CLI::Option* option, long long lo, long long hi) {
 }  // namespace
 
 void add_scene_options(CLI::App& app, SceneArgs& a) {
-  file_option(app.add_option("scene,-m,--scene", a.scene, "OBJ file to render (default: the built-in Cornell box)"));
+  file_option(app.add_option("scene,-m,--scene", a.scene,
+                             "scene to render: .obj, .gltf, .glb or .ply (default: the built-in Cornell box)"));
   app.add_option("--view", a.view, "render a named view: its scene, camera and light (e.g. sponza, cornell-water)");
   file_option(app.add_option("--views", a.views, "the views file for --view (default ../shared/scenes/views.tsv)"));
   app.add_option("--builtin-spheres", a.builtin_spheres,
@@ -61,7 +62,8 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
                      "path, whitted: light the scene from beyond with this equirectangular environment map (.exr or "
                      ".hdr, linear radiance; times --env)"));
   app.add_option("--env-rotation", a.env_rotation, "degrees the --env-map turns about +y")->capture_default_str();
-  whole_option(app.add_option("--max-input-mib", a.max_input_mib, "largest OBJ file read, in MiB (1-1048576)"), 1,
+  app.add_option("--camera", a.camera, "a glTF scene's camera N, counting from 0 in node order (default 0)");
+  whole_option(app.add_option("--max-input-mib", a.max_input_mib, "largest scene file read, in MiB (1-1048576)"), 1,
                1 << 20)
       ->capture_default_str();
   whole_option(

@@ -9,7 +9,7 @@
 
 #include "accel/accelerator.hpp"
 #include "driver/render_driver.hpp"
-#include "importers/obj_loader.hpp"
+#include "importers/load_limits.hpp"
 #include "io/exr_io.hpp"
 #include "render/render_image.hpp"
 
@@ -21,7 +21,7 @@ class App;  // CLI11: only the files that add or parse flags include it (a heavy
 namespace tracer::driver {
 
 struct SceneArgs {
-  std::string scene;  // empty: the built-in Cornell box
+  std::string scene;  // empty: the built-in Cornell box; .obj, .gltf, .glb or .ply
   std::string view;   // a view of the views file: its scene, camera and light
   std::string views;  // empty: ../shared/scenes/views.tsv
   int builtin_spheres = 0;
@@ -30,7 +30,8 @@ struct SceneArgs {
   std::optional<double> light_intensity;
   std::string env_map;        // an equirectangular .exr or .hdr lighting the scene from beyond
   double env_rotation = 0.0;  // degrees about +y
-  long long max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the OBJ
+  std::optional<int> camera;  // --camera: which of a glTF's cameras (default its first)
+  long long max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the scene file
   long long max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
 };
 

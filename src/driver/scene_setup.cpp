@@ -8,6 +8,7 @@
 #include "base/errors.hpp"
 #include "driver/output_checks.hpp"
 #include "driver/parse.hpp"
+#include "importers/scene_file.hpp"
 #include "io/environment_io.hpp"
 #include "parallel/executor.hpp"
 #include "scene/builtin.hpp"
@@ -77,14 +78,24 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
     if (!a.scene.empty() && !same_file(a.scene, view.obj)) {
       throw UsageError("--view: view '" + a.view + "' is of " + view.obj + ", not of the scene " + a.scene);
     }
-    Scene scene = load_obj(view.obj, warn, cancel, limits, phases);
+    Scene scene = load_scene_file(view.obj, warn, cancel, limits, phases);
     apply_view_light(scene, view);
     scene.camera = view.camera;
     add_lights(scene, a);
     add_environment(scene, a, cancel, warn);
     return scene;
   }
-  Scene scene = a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_obj(a.scene, warn, cancel, limits, phases);
+  Scene scene =
+      a.scene.empty() ? make_cornell_box(a.builtin_spheres) : load_scene_file(a.scene, warn, cancel, limits, phases);
+  if (a.camera) {
+    if (scene.cameras.empty()) throw UsageError("--camera: the scene places no cameras");
+    if (*a.camera < 0 || size_t(*a.camera) >= scene.cameras.size()) {
+      throw UsageError("--camera: " + std::to_string(*a.camera) + " is not one of the scene's " +
+                       std::to_string(scene.cameras.size()) + " cameras (0 to " +
+                       std::to_string(scene.cameras.size() - 1) + ")");
+    }
+    scene.camera = scene.cameras[size_t(*a.camera)];
+  }
   // A scene with no light of its own (Sponza, Sibenik, the Bunny) that a views.tsv beside it
   // knows: its view's camera, and its light unless --light gives one, so a plain render shows it
   // as the views mean it (from inside, lit) rather than framed from outside in the dark.

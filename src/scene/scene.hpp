@@ -119,6 +119,7 @@ struct Scene {
   size_t degenerate_count = 0;
   Aabb bounds;
   std::optional<CameraSpec> camera;  // a camera the scene itself suggests (the built-in box)
+  std::vector<CameraSpec> cameras;   // the cameras the file places (glTF), in node order
 
   size_t size() const { return triangles.size(); }
   // The intensity of a point light when none is given (--light, a view's light): (diagonal / 2)^2.

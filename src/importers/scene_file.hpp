@@ -1,0 +1,22 @@
+// Which importer reads a scene file: by its extension (.obj, .gltf, .glb, .ply, in any case);
+// anything else, and standard input, is read as OBJ.
+#pragma once
+
+#include <string>
+
+#include "importers/load_limits.hpp"
+#include "importers/warning_log.hpp"
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+enum class SceneFormat { Obj, Gltf, Ply };
+
+SceneFormat scene_format(const std::string& path);
+
+// Loads `path` with the importer its format calls for (importers/obj_loader.hpp,
+// gltf_loader.hpp, ply_loader.hpp): the same errors, warnings, limits and cancellation.
+Scene load_scene_file(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr,
+                      const LoadLimits& limits = {}, LoadPhases* phases = nullptr);
+
+}  // namespace tracer
