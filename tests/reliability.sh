@@ -15,6 +15,26 @@ trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
 # Written before ok.obj: files newer than ok.obj are what a case left behind, and are removed.
+# glTF and PLY: one triangle, its positions then uint16 indices, in a data: URI or a file.
+printf '\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\077\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\077\0\0\0\0\0\0\001\0\002\0\0\0' > tri.bin
+gltf() {  # NODES INDEX-COUNT BUFFER-URI
+  printf '{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":%s,"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"buffers":[{"uri":"%s","byteLength":44}],"bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":8}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},{"bufferView":1,"componentType":5123,"count":%s,"type":"SCALAR"}]}\n' "$1" "$3" "$2"
+}
+data="data:application/octet-stream;base64,$(base64 -w0 tri.bin)"
+gltf '[{"mesh":0}]' 3 "$data" > tri.gltf
+gltf '[{"mesh":0}]' 1000000000 "$data" > count.gltf
+gltf '[{"mesh":0,"children":[1]},{"children":[0]}]' 3 "$data" > cycle.gltf
+nodes='[{"mesh":0,"children":[1,1]}'
+for i in $(seq 1 39); do nodes+=",{\"mesh\":0,\"children\":[$((i + 1)),$((i + 1))]}"; done
+gltf "$nodes"',{"mesh":0}]' 3 "$data" > expand.gltf
+mkdir gltfdir && mv tri.bin secret.bin
+gltf '[{"mesh":0}]' 3 "../secret.bin" > gltfdir/escape.gltf
+printf 'glTF\002\000\000\000\377\377\000\000\040\000\000\000JSON{"asset":' > cut.glb
+ply='ply\nformat %s 1.0\nelement vertex %s\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > tri.ply
+printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 4000000000 > count.ply
+printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n' ascii 3 > range.ply
+{ printf "$ply" binary_little_endian 3; head -c 36 /dev/zero; printf '\003\0\0\0'; } > cut.ply
 printf 'mtllib dark.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 100 100 100\nv 101 100 100\nv 100 101 100\nf 1 2 3\nusemtl lamp\nf 4 6 5\n' > dark.obj
 printf 'newmtl lamp\nKe 10 10 10\n' > dark.mtl
 printf 'mtllib grey.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n' > grey.obj
@@ -215,6 +235,17 @@ cases=(
   "NaN coordinate|tracer render nan.obj -q|1"
   "face index out of range|tracer render range.obj -q|1"
   "no triangles|tracer render empty.obj -q|1"
+  "glTF: one triangle|tracer render tri.gltf -q --width 32 --height 32 -o g.png|0"
+  "glTF: an accessor's count past its buffer|tracer render count.gltf -q|1"
+  "glTF: a buffer URI that leaves the scene's folder|tracer render gltfdir/escape.gltf -q|1"
+  "glTF: nodes in a cycle|tracer render cycle.gltf -q|1"
+  "glTF: 2^40 instances of a triangle in 1 KB|tracer render expand.gltf -q|1"
+  "glTF: a .glb cut short|tracer render cut.glb -q|1"
+  "glTF: --camera of a scene without cameras|tracer render tri.gltf --camera 0 -q|2"
+  "PLY: one triangle|tracer render tri.ply -q --width 32 --height 32 -o p.png|0"
+  "PLY: a vertex count the file cannot hold|tracer render count.ply -q|1"
+  "PLY: a face index out of range|tracer render range.ply -q|1"
+  "PLY: binary data cut short|tracer render cut.ply -q|1"
   "all vertices coincide, no camera flags|tracer render same.obj -q|1"
   "control character in a number|tracer render control.obj -q|1"
   "UTF-8 byte-order mark, +1, 1e-50|tracer render bom.obj -q --width 32 --height 32|0"
