@@ -22,6 +22,7 @@
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
+#include "scene/camera.hpp"
 #include "test_util.hpp"
 #include "view/view_command.hpp"
 #include "view/view_server.hpp"
@@ -119,6 +120,11 @@ TEST_F(ViewServerTest, BadChangesAreRefusedWithAMessageAndChangeNothing) {
       {R"({"max_depth": 65})", "max_depth: 65 is outside [0, 64]"},
       {R"({"exposure": -1})", "exposure: -1 is outside"},
       {R"({"fov": 180})", "fov: 180 is outside"},
+      {R"({"aperture": -1})", "aperture: -1 is outside"},
+      {R"({"focus_distance": 0})", "focus_distance: 0 is outside"},
+      {R"({"focus_at": [1]})", "focus_at: expected [x, y]"},
+      {R"({"focus_at": [-5, 3]})", "focus_at: -5.000000,3.000000 lies outside the 64x48 image"},
+      {R"({"eye": [1, 1, -3], "look": [1, 1, -10], "focus_at": [32, 24]})", "focus_at: nothing there to focus on"},
       {R"({"integrator": "raster"})", "integrator: unknown integrator 'raster'"},
       {R"({"eye": [0, 1]})", "eye: expected [x, y, z]"},
       {R"({"eye": [0, 1, 1e300]})", "eye: 1e+300 is outside"},
@@ -157,6 +163,33 @@ TEST_F(ViewServerTest, ChangesRestartTheAccumulationExposureOnlyRetones) {
   EXPECT_EQ(s["exposure"], 3.0);
 }
 
+// A click focuses the lens on the surface under it: the focus distance is that surface's distance
+// along the view (brute force finds the same hit), and the copied command carries it.
+TEST_F(ViewServerTest, AClickSetsTheFocusDistanceToTheSurfaceThere) {
+  auto r = post(R"({"aperture": 0.02, "focus_at": [20.5, 30.5]})");
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json s = json::parse(r->body);
+  CameraSpec spec;
+  spec.eye = Vec3{s["eye"][0], s["eye"][1], s["eye"][2]};
+  spec.look = Vec3{s["look"][0], s["look"][1], s["look"][2]};
+  spec.up = Vec3{s["up"][0], s["up"][1], s["up"][2]};
+  spec.fov_degrees = s["fov"];
+  const Camera camera(spec, 64, 48);
+  const Ray ray = camera.ray_through(20.5f, 30.5f);
+  const Accelerator brute = build_accelerator(scene_, AccelOptions{.kind = AccelKind::Brute});
+  Hit hit;
+  ASSERT_TRUE(brute.visit([&](const auto& accel) { return accel.intersect(ray, hit); }));
+  const float want = hit.t * dot(ray.dir, camera.forward());
+  EXPECT_NEAR(float(s["focus_distance"]), want, 1e-5f * want);
+  EXPECT_EQ(s["aperture"], 0.02f);
+  const std::string command = s["command"];
+  EXPECT_NE(command.find("--aperture 0.02 --focus-distance "), std::string::npos) << command;
+  // Another surface, another distance; the lens stays.
+  r = post(R"({"focus_at": [32, 2]})");
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(json::parse(r->body)["focus_distance"], s["focus_distance"]);
+}
+
 // The claim of the viewer: what it shows of a finished state is `tracer render`'s image, byte for
 // byte, with the command it copies; for every integrator, and after a camera change.
 TEST_F(ViewServerTest, FinishedImageIsTheCopiedCommandsRender) {
@@ -164,6 +197,7 @@ TEST_F(ViewServerTest, FinishedImageIsTheCopiedCommandsRender) {
       R"({"eye": [0.3, 1.1, 2.6], "look": [0, 0.9, 0], "spp": 3})",
       R"({"integrator": "ao", "spp": 1, "width": 40})",
       R"({"integrator": "whitted", "spp": 2, "fov": 60, "exposure": 2.5})",
+      R"({"integrator": "path", "spp": 2, "aperture": 0.05, "focus_at": [40, 20]})",
   };
   for (const std::string& change : changes) {
     ASSERT_EQ(post(change)->status, 200) << change;

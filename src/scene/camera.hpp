@@ -59,6 +59,9 @@ class Camera {
     inv_h_ = 1.0f / float(height);
   }
 
+  // The unit view direction, and the distance along it of the plane in focus.
+  Vec3 forward() const { return forward_; }
+  float focus_distance() const { return focus_; }
   // The angle one pixel spans at the image centre: the spread of a ray cone through a pixel.
   float pixel_spread() const { return 2.0f * length(dv_) * inv_h_; }
   // The ray through the centre of pixel (x, y).

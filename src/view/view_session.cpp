@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -64,6 +65,11 @@ Vec3 vec_field(const std::string& key, const nlohmann::json& value) {
   return v;
 }
 
+Vec2 vec2_field(const std::string& key, const nlohmann::json& value) {
+  if (!value.is_array() || value.size() != 2) throw UsageError(key + ": expected [x, y], got " + value.dump());
+  return {float(number_field(key, value[0], -1e6, 1e6)), float(number_field(key, value[1], -1e6, 1e6))};
+}
+
 bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
 
 }  // namespace
@@ -101,6 +107,16 @@ std::string render_command(const driver::RenderArgs& a, const std::vector<std::s
     if (!drop) out += " " + shell_quote(t);
   }
   out += " --eye " + a.eye + " --look " + a.look + " --up " + a.up + " --fov " + format_float(*a.fov);
+  // The shortest text that reads back as the same double: the command's camera is the view's.
+  const auto shortest = [](double v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    return std::string(text, end);
+  };
+  if (a.aperture && *a.aperture > 0.0) {
+    out += " --aperture " + shortest(*a.aperture);
+    if (a.focus_distance) out += " --focus-distance " + shortest(*a.focus_distance);
+  }
   out += " --width " + std::to_string(a.settings.width) + " --height " + std::to_string(a.settings.height);
   out += " --integrator " + a.integrator + " --spp " + std::to_string(*a.spp);
   out += " --max-depth " + std::to_string(a.settings.max_depth) + " --exposure " + format_float(a.settings.exposure);
@@ -150,6 +166,7 @@ void ViewSession::stop() {
 nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   if (!change.is_object()) throw UsageError("expected a JSON object of fields to change, got " + change.dump());
   nlohmann::json result;
+  std::optional<Vec2> focus_at;
   bool exposure_changed = false;
   float exposure = 0.0f;
   {
@@ -164,6 +181,12 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
         a.up = vec_text(vec_field(key, value));
       } else if (key == "fov") {
         a.fov = double(float(number_field(key, value, 1e-3, 179.0)));
+      } else if (key == "aperture") {
+        a.aperture = number_field(key, value, 0.0, 1e6);
+      } else if (key == "focus_distance") {
+        a.focus_distance = number_field(key, value, 1e-6, 1e12);
+      } else if (key == "focus_at") {
+        focus_at = vec2_field(key, value);
       } else if (key == "integrator") {
         if (!value.is_string()) throw UsageError("integrator: expected a name, got " + value.dump());
         a.integrator = value.get<std::string>();
@@ -180,18 +203,21 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
         a.settings.height = int_field(key, value, 1, kMaxViewSide);
       } else {
         throw UsageError("unknown field '" + key +
-                         "' (eye, look, up, fov, integrator, spp, max_depth, exposure, width, height)");
+                         "' (eye, look, up, fov, aperture, focus_distance, focus_at, integrator, spp, max_depth, "
+                         "exposure, width, height)");
       }
     }
     // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
     // looking at its own position or along its up vector).
     driver::validate(a);
+    if (focus_at) a.focus_distance = focus_distance_at(a, *focus_at);
     const CameraSpec camera = driver::camera_for(scene_, a);
     std::string note;
     const RenderSettings settings = driver::settings_for(a, scene_, note);
     exposure_changed = settings.exposure != job_.settings.exposure;
     exposure = settings.exposure;
     const bool same_view = a.eye == args_.eye && a.look == args_.look && a.up == args_.up && a.fov == args_.fov &&
+                           a.aperture == args_.aperture && a.focus_distance == args_.focus_distance &&
                            a.integrator == args_.integrator && a.settings.max_depth == args_.settings.max_depth &&
                            a.settings.width == args_.settings.width && a.settings.height == args_.settings.height;
     const bool restart = !same_view || a.spp != args_.spp;
@@ -221,6 +247,20 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   return result;
 }
 
+float ViewSession::focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const {
+  const int w = a.settings.width, h = a.settings.height;
+  if (!(pixel.x >= 0.0f && pixel.x <= float(w) && pixel.y >= 0.0f && pixel.y <= float(h))) {
+    throw UsageError("focus_at: " + std::to_string(pixel.x) + "," + std::to_string(pixel.y) + " lies outside the " +
+                     std::to_string(w) + "x" + std::to_string(h) + " image");
+  }
+  const Camera camera(driver::camera_for(scene_, a), w, h);
+  Ray ray = camera.ray_through(pixel.x, pixel.y);
+  Hit hit;
+  const bool found = accel_.visit([&](const auto& accel) { return accel.intersect(ray, hit); });
+  if (!found) throw UsageError("focus_at: nothing there to focus on (the ray leaves the scene)");
+  return hit.t * dot(ray.dir, camera.forward());
+}
+
 nlohmann::json ViewSession::state() const {
   const std::lock_guard lock(mu_);
   return state_locked();
@@ -233,6 +273,8 @@ nlohmann::json ViewSession::state_locked() const {
           {"look", vec_json(c.look)},
           {"up", vec_json(c.up)},
           {"fov", c.fov_degrees},
+          {"aperture", c.lens_radius},
+          {"focus_distance", Camera(c, args_.settings.width, args_.settings.height).focus_distance()},
           {"integrator", args_.integrator},
           {"spp", *args_.spp},
           {"max_depth", args_.settings.max_depth},

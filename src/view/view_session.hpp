@@ -33,9 +33,9 @@ inline constexpr int kMaxViewSide = 4096;
 
 // The flags of a `tracer render` command that the viewer's state sets, each taking one value. The
 // viewer's "copy command" drops them from the user's own flags and writes the current ones.
-inline constexpr const char* kStateFlags[] = {"--eye",        "-v",          "--look",     "--up",
-                                              "--fov",        "--width",     "--height",   "--spp",
-                                              "--integrator", "--max-depth", "--exposure", "-l"};
+inline constexpr const char* kStateFlags[] = {
+    "--eye", "-v",           "--look",      "--up",       "--fov", "--width",    "--height",
+    "--spp", "--integrator", "--max-depth", "--exposure", "-l",    "--aperture", "--focus-distance"};
 
 // The command line of `tracer render` for `args`: `user_flags` (the view command's own arguments)
 // without the state's flags and the viewer's own (`viewer_flags`, each taking one value), then the
@@ -102,6 +102,9 @@ class ViewSession {
   nlohmann::json state_locked() const;
 
   const Scene& scene_;
+  // The distance along the view of the surface seen at image position `pixel` (a click that
+  // sets the focus); UsageError where the ray finds nothing or the position is off the image.
+  float focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const;
   const Accelerator& accel_;
   const SchedOptions sched_;
   const std::vector<std::string> user_flags_, viewer_flags_;
