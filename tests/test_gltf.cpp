@@ -381,7 +381,8 @@ INSTANTIATE_TEST_SUITE_P(Scenes, Conversions,
 // boxes (framed from their bounds, lit by their lamps, materials mapped both ways) byte for byte;
 // Sponza and the Bunny through the camera and light their views give, which the glTF carries as a
 // camera node and a KHR_lights_punctual light: the camera's direction is rebuilt from its matrix
-// (float rounding), so there the golden tolerance, PSNR >= 40 dB.
+// (float rounding), so there the golden tolerance, PSNR >= 40 dB. The Bunny's PLY, given its
+// view's camera and light as flags, byte for byte.
 TEST(ConvertedScenes, RenderTheSameImageAsTheirObj) {
   if (!test::have_shared_scenes()) GTEST_SKIP() << "../shared/scenes not found";
   struct Case {
@@ -411,6 +412,17 @@ TEST(ConvertedScenes, RenderTheSameImageAsTheirObj) {
       EXPECT_GE(test::psnr(read_image(dir + "/obj.png"), read_image(dir + "/glb.png")), 40.0) << c.obj;
     }
   }
+  // PLY carries no camera or light: the Bunny's PLY through its view's flags is its OBJ's image.
+  test::write_ply(load_obj(test::scene_path("bunny/bunny.obj"), [](const std::string&) {}), dir + "/b.ply",
+                  test::PlyEncoding::BinaryLittle);
+  const std::string flags = " -q --width 48 --height 36 --integrator ao ";
+  const auto obj = test::run_tracer("render " + test::scene_path("bunny/bunny.obj") + flags + "-o " + dir + "/o.png");
+  const auto ply = test::run_tracer("render " + dir + "/b.ply" + flags +
+                                    "--eye -0.15,0.9,3 --look -0.15,0.83,0.07 --up 0,1,0 --fov 40 --light 1,3,3 -o " +
+                                    dir + "/p.png");
+  ASSERT_EQ(obj.exit_code, 0) << obj.output;
+  ASSERT_EQ(ply.exit_code, 0) << ply.output;
+  EXPECT_EQ(test::read_bytes(dir + "/o.png"), test::read_bytes(dir + "/p.png"));
   fs::remove_all(dir);
 }
 

@@ -103,6 +103,14 @@ int cmd_info(const SceneArgs& args) {
     std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x,
                 l.position.y, l.position.z, l.power.x, l.power.y, l.power.z);
   }
+  if (!scene.cameras.empty()) {
+    std::printf("cameras     %zu (--camera N)\n", scene.cameras.size());
+    for (size_t i = 0; i < scene.cameras.size(); ++i) {
+      const CameraSpec& c = scene.cameras[i];
+      std::printf("  %zu at (%g, %g, %g), looking at (%g, %g, %g), fov %g\n", i, c.eye.x, c.eye.y, c.eye.z, c.look.x,
+                  c.look.y, c.look.z, c.fov_degrees);
+    }
+  }
   std::printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", scene.bounds.lo.x, scene.bounds.lo.y, scene.bounds.lo.z,
               scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
   return 0;
@@ -124,7 +132,7 @@ int main(int argc, char** argv) {
   using namespace tracer;
   using namespace tracer::cli;
   using namespace tracer::driver;
-  CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ scenes"};
+  CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ, glTF 2.0 and PLY scenes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "tracer 0.1.0");
 
