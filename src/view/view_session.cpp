@@ -210,10 +210,17 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
     // looking at its own position or along its up vector).
     driver::validate(a);
-    if (focus_at) a.focus_distance = focus_distance_at(a, *focus_at);
-    const CameraSpec camera = driver::camera_for(scene_, a);
     std::string note;
-    const RenderSettings settings = driver::settings_for(a, scene_, note);
+    if (focus_at) {
+      if (const std::optional<float> d = focus_distance_at(a, *focus_at)) {
+        a.focus_distance = double(*d);
+      } else {
+        note = "nothing there to focus on: the focus stays";
+      }
+    }
+    const CameraSpec camera = driver::camera_for(scene_, a);
+    std::string settings_note;
+    const RenderSettings settings = driver::settings_for(a, scene_, settings_note);
     exposure_changed = settings.exposure != job_.settings.exposure;
     exposure = settings.exposure;
     const bool same_view = a.eye == args_.eye && a.look == args_.look && a.up == args_.up && a.fov == args_.fov &&
@@ -234,6 +241,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
       last_change_ = now;
     }
     result = state_locked();
+    if (!note.empty()) result["note"] = note;
   }
   cv_.notify_all();
   if (exposure_changed) {
@@ -247,7 +255,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   return result;
 }
 
-float ViewSession::focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const {
+std::optional<float> ViewSession::focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const {
   const int w = a.settings.width, h = a.settings.height;
   if (!(pixel.x >= 0.0f && pixel.x <= float(w) && pixel.y >= 0.0f && pixel.y <= float(h))) {
     throw UsageError("focus_at: " + std::to_string(pixel.x) + "," + std::to_string(pixel.y) + " lies outside the " +
@@ -257,7 +265,7 @@ float ViewSession::focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) co
   Ray ray = camera.ray_through(pixel.x, pixel.y);
   Hit hit;
   const bool found = accel_.visit([&](const auto& accel) { return accel.intersect(ray, hit); });
-  if (!found) throw UsageError("focus_at: nothing there to focus on (the ray leaves the scene)");
+  if (!found) return std::nullopt;
   return hit.t * dot(ray.dir, camera.forward());
 }
 
@@ -273,7 +281,7 @@ nlohmann::json ViewSession::state_locked() const {
           {"look", vec_json(c.look)},
           {"up", vec_json(c.up)},
           {"fov", c.fov_degrees},
-          {"aperture", c.lens_radius},
+          {"aperture", args_.aperture.value_or(0.0)},  // as the command gives it
           {"focus_distance", Camera(c, args_.settings.width, args_.settings.height).focus_distance()},
           {"integrator", args_.integrator},
           {"spp", *args_.spp},

@@ -103,8 +103,8 @@ class ViewSession {
 
   const Scene& scene_;
   // The distance along the view of the surface seen at image position `pixel` (a click that
-  // sets the focus); UsageError where the ray finds nothing or the position is off the image.
-  float focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const;
+  // sets the focus): nothing where the ray leaves the scene; UsageError off the image.
+  std::optional<float> focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const;
   const Accelerator& accel_;
   const SchedOptions sched_;
   const std::vector<std::string> user_flags_, viewer_flags_;

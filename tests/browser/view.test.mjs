@@ -144,6 +144,16 @@ try {
   s = await settledState(beforeFly.generation);
   assert.ok(dist(s.eye, beforeFly.look) < dist(beforeFly.eye, beforeFly.look), 'W flies toward the look point');
 
+  // A lens from the panel; a click (no drag) focuses it on the surface under the pointer.
+  await page.fill('#aperture', '0.05');
+  await page.press('#aperture', 'Enter');
+  s = await settledState(s.generation);
+  assert.equal(s.aperture, 0.05);
+  await page.mouse.click(cx, cy);
+  const focused = await settledState(s.generation);
+  assert.notEqual(focused.focus_distance, s.focus_distance, 'a click sets the focus distance');
+  assert.match(focused.command, /--aperture 0.05 --focus-distance /);
+
   // The panel: another integrator and target; a bad value gets the server's message.
   await page.selectOption('#integrator', 'ao');
   await page.fill('#spp-target', '4');
