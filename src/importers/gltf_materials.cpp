@@ -1,0 +1,208 @@
+#include "importers/gltf_materials.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "base/byte_budget.hpp"
+#include "base/text.hpp"
+
+namespace tracer::gltf {
+
+namespace fs = std::filesystem;
+namespace tg = tinygltf;
+
+uint32_t Materials::material(int index, Scene& scene) {
+  if (index >= 0 && size_t(index) >= model_.materials.size()) {
+    throw error("material " + std::to_string(index) + " does not exist (the file has " +
+                std::to_string(model_.materials.size()) + ")");
+  }
+  auto [it, fresh] = materials_.try_emplace(index, uint32_t(scene.materials.size()));
+  if (!fresh) return it->second;
+  if (index < 0) {
+    scene.materials.push_back(Material{});
+    return it->second;
+  }
+  scene.materials.push_back(map_material(model_.materials[size_t(index)], index));
+  return it->second;
+}
+
+// docs/FORMATS.md: how glTF's metallic-roughness model becomes tracer's.
+Material Materials::map_material(const tg::Material& g, int index) {
+  Material mat;
+  mat.name = g.name.empty() ? "material " + std::to_string(index) : g.name;
+  const tg::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+  const Vec3 base = vec3_of(pbr.baseColorFactor, Vec3{1.0f});
+  const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+  const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+  if (!is_finite(base) || !std::isfinite(pbr.metallicFactor) || !std::isfinite(pbr.roughnessFactor)) {
+    throw error("material " + in_quotes(mat.name) + " has a non-finite factor");
+  }
+  if (g.alphaMode != "OPAQUE" || (pbr.baseColorFactor.size() == 4 && pbr.baseColorFactor[3] < 1.0)) {
+    warnings_.add("alpha (alphaMode " + g.alphaMode + ", base colour alpha) not rendered: surfaces are opaque");
+  }
+  if (pbr.metallicRoughnessTexture.index >= 0) {
+    warnings_.add("metallicRoughnessTexture not used: its material's factors are");
+  }
+  if (g.emissiveTexture.index >= 0) warnings_.add("emissiveTexture not used: the emissive factor is");
+  const tg::Value* strength = extension(g.extensions, "KHR_materials_emissive_strength");
+  const double emissive_strength = number(strength, "emissiveStrength", 1.0);
+  if (g.emissiveFactor.size() >= 3) {
+    mat.ke = {float(g.emissiveFactor[0] * emissive_strength), float(g.emissiveFactor[1] * emissive_strength),
+              float(g.emissiveFactor[2] * emissive_strength)};
+  }
+  const tg::Value* transmission = extension(g.extensions, "KHR_materials_transmission");
+  const float transmitted = float(number(transmission, "transmissionFactor", 0.0));
+  const float ior = float(number(extension(g.extensions, "KHR_materials_ior"), "ior", 1.5));
+  const tg::Value* specular = extension(g.extensions, "KHR_materials_specular");
+  const float specular_factor = float(number(specular, "specularFactor", 1.0));
+  Vec3 specular_colour{1.0f};
+  if (specular && specular->IsObject() && specular->Has("specularColorFactor")) {
+    const tg::Value& c = specular->Get("specularColorFactor");
+    if (c.IsArray() && c.ArrayLen() == 3) {
+      specular_colour = {float(c.Get(0).GetNumberAsDouble()), float(c.Get(1).GetNumberAsDouble()),
+                         float(c.Get(2).GetNumberAsDouble())};
+    }
+  }
+  if (!is_finite(mat.ke) || !std::isfinite(transmitted) || !std::isfinite(ior) || !std::isfinite(specular_factor) ||
+      !is_finite(specular_colour) || mat.ke.x < 0.0f || mat.ke.y < 0.0f || mat.ke.z < 0.0f) {
+    throw error("material " + in_quotes(mat.name) + " has a non-finite or negative extension value");
+  }
+  // The dielectric reflectance at normal incidence: ((ior - 1) / (ior + 1))^2, 0.04 at 1.5.
+  const float f0_ior = ior >= 1.0f ? ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f)) : 0.04f;
+  const Vec3 f0 = min(specular_colour * f0_ior, Vec3{1.0f}) * std::max(specular_factor, 0.0f);
+  Vec3 diffuse_tint{1.0f};
+  if (transmitted > 0.0f) {
+    if (transmitted < 1.0f) warnings_.add("partial transmission rendered as full transmission (glass)");
+    if (roughness > 0.0f) warnings_.add("rough transmission rendered smooth");
+    mat.illum = 7;
+    mat.ni = ior > 0.0f ? ior : 1.5f;
+    mat.tf = base;
+    mat.kd = base;
+  } else if (metallic >= 1.0f && roughness == 0.0f) {
+    mat.illum = 3;
+    mat.ks = base;
+    mat.kd = Vec3{0.0f};
+  } else {
+    mat.illum = 2;
+    mat.kd = base * (1.0f - metallic);
+    mat.ks = f0 * (1.0f - metallic) + base * metallic;
+    // GGX alpha = roughness^2 (glTF); tracer's glossy lobe reads it from a Phong exponent.
+    const float alpha = std::max(roughness * roughness, 1e-4f);
+    mat.ns = 2.0f / (alpha * alpha) - 2.0f;
+    diffuse_tint = Vec3{1.0f - metallic};
+    if (metallic > 0.0f && pbr.baseColorTexture.index >= 0) {
+      warnings_.add("a metallic base colour texture tints the specular by its factor only");
+    }
+  }
+  if (pbr.baseColorTexture.index >= 0 && mat.illum == 2) {
+    mat.diffuse_texture =
+        texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, false, base * diffuse_tint);
+  }
+  if (g.normalTexture.index >= 0) {
+    mat.normal_texture = texture(g.normalTexture.index, g.normalTexture.texCoord, true, Vec3{1.0f});
+    mat.normal_scale = float(g.normalTexture.scale);
+    if (!std::isfinite(mat.normal_scale)) throw error("material " + in_quotes(mat.name) + ": normal scale not finite");
+  }
+  return mat;
+}
+
+uint32_t Materials::texture(int index, int tex_coord, bool data, Vec3 tint) {
+  if (size_t(index) >= model_.textures.size()) throw error("texture " + std::to_string(index) + " does not exist");
+  const tg::Texture& t = model_.textures[size_t(index)];
+  if (t.source < 0 || size_t(t.source) >= model_.images.size()) {
+    throw error("texture " + std::to_string(index) + ": image " + std::to_string(t.source) + " does not exist");
+  }
+  if (tex_coord != 0) warnings_.add("texture coordinate sets other than TEXCOORD_0 not used: TEXCOORD_0 is");
+  if (t.sampler >= 0 && size_t(t.sampler) < model_.samplers.size()) {
+    const tg::Sampler& s = model_.samplers[size_t(t.sampler)];
+    if (s.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT || s.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT) {
+      warnings_.add("texture wrap modes other than repeat rendered as repeat");
+    }
+  }
+  if (extension(t.extensions, "KHR_texture_transform")) warnings_.add("KHR_texture_transform not applied");
+  const TextureUse use{t.source, data, data ? Vec3{1.0f} : tint};
+  const auto [it, fresh] = texture_slots_.try_emplace(use, uint32_t(texture_uses_.size()));
+  if (fresh) texture_uses_.push_back(use);
+  return it->second;
+}
+
+void Materials::attach_textures(Scene& scene) {
+  std::vector<int> images;
+  for (const TextureUse& u : texture_uses_) images.push_back(u.image);
+  std::sort(images.begin(), images.end());
+  images.erase(std::unique(images.begin(), images.end()), images.end());
+  std::vector<EncodedTexture> encoded(images.size());
+  std::vector<std::string> problem(images.size());
+  std::vector<std::optional<Texture>> decoded(images.size());
+  const auto guarded = [&](size_t k, auto&& work) {
+    try {
+      work();
+    } catch (const InputError& e) {
+      problem[k] = e.what();
+    }
+  };
+  limits_.for_each(images.size(), [&](size_t k) { guarded(k, [&] { encoded[k] = read_image(images[k]); }); });
+  throw_if_cancelled(cancel_);
+  uint64_t kept = 0, largest_transient = 0;
+  const uint64_t budget = limits_.textures.max_total_bytes;
+  for (size_t k = 0; k < images.size(); ++k) {
+    if (!problem[k].empty()) continue;
+    const uint64_t final_bytes = encoded[k].decoded_bytes();
+    const uint64_t transient = encoded[k].decode_peak_bytes() - final_bytes;
+    if (kept + final_bytes + std::max(largest_transient, transient) > budget) {
+      problem[k] = encoded[k].name + ": the scene's textures would take more than " + std::to_string(budget >> 20) +
+                   " MiB to decode (--max-texture-mib raises it)";
+      encoded[k] = {};
+      continue;
+    }
+    kept += final_bytes;
+    largest_transient = std::max(largest_transient, transient);
+  }
+  ByteBudget transients(budget - kept);
+  limits_.for_each(images.size(), [&](size_t k) {
+    if (problem[k].empty()) {
+      const ByteBudget::Taken held(transients, encoded[k].decode_peak_bytes() - encoded[k].decoded_bytes());
+      guarded(k, [&] { decoded[k] = decode_texture(encoded[k]); });
+    }
+    encoded[k] = {};
+  });
+  throw_if_cancelled(cancel_);
+  // Slot -> scene texture (kInvalidIndex where its image failed).
+  std::vector<uint32_t> slot_texture(texture_uses_.size(), kInvalidIndex);
+  for (size_t s = 0; s < texture_uses_.size(); ++s) {
+    const TextureUse& u = texture_uses_[s];
+    const size_t k = size_t(std::lower_bound(images.begin(), images.end(), u.image) - images.begin());
+    if (!decoded[k]) continue;
+    slot_texture[s] = uint32_t(scene.textures.size());
+    scene.textures.push_back(u.tint == Vec3{1.0f} ? *decoded[k] : decoded[k]->tinted(u.tint));
+  }
+  for (size_t k = 0; k < images.size(); ++k) {
+    if (!problem[k].empty()) warnings_.add("texture not used: " + problem[k]);
+  }
+  for (Material& m : scene.materials) {
+    if (m.diffuse_texture != kInvalidIndex) m.diffuse_texture = slot_texture[m.diffuse_texture];
+    if (m.normal_texture != kInvalidIndex) m.normal_texture = slot_texture[m.normal_texture];
+  }
+}
+
+EncodedTexture Materials::read_image(int index) const {
+  const tg::Image& image = model_.images[size_t(index)];
+  const std::string what = "image " + std::to_string(index);
+  if (!image.image.empty()) {
+    return encoded_texture(name_ + " " + what, std::string(image.image.begin(), image.image.end()), limits_.textures);
+  }
+  if (image.bufferView >= 0) throw InputError(name_ + " " + what + ": its buffer view could not be read");
+  if (image.uri.empty()) throw InputError(name_ + " " + what + ": neither a URI nor a buffer view");
+  if (base_dir_.empty()) throw InputError(name_ + " " + what + ": a scene read from memory refers to no files");
+  const std::string uri = decode_uri(image.uri);
+  std::string why;
+  FileFinder finder;
+  const std::optional<fs::path> file = finder.find(base_dir_, uri);
+  if (!file) throw InputError((base_dir_ / uri).string() + ": not found");
+  if (!inside_folder(fs::weakly_canonical(base_dir_), file->string(), &why))
+    throw InputError(name_ + " " + what + ": " + why);
+  return read_texture(*file, limits_.textures, cancel_);
+}
+
+}  // namespace tracer::gltf
