@@ -4,8 +4,8 @@
 #include <cmath>
 #include <optional>
 
-#include "base/byte_budget.hpp"
 #include "base/text.hpp"
+#include "importers/texture_batch.hpp"
 
 namespace tracer::gltf {
 
@@ -132,53 +132,20 @@ void Materials::attach_textures(Scene& scene) {
   for (const TextureUse& u : texture_uses_) images.push_back(u.image);
   std::sort(images.begin(), images.end());
   images.erase(std::unique(images.begin(), images.end()), images.end());
-  std::vector<EncodedTexture> encoded(images.size());
-  std::vector<std::string> problem(images.size());
-  std::vector<std::optional<Texture>> decoded(images.size());
-  const auto guarded = [&](size_t k, auto&& work) {
-    try {
-      work();
-    } catch (const InputError& e) {
-      problem[k] = e.what();
-    }
-  };
-  limits_.for_each(images.size(), [&](size_t k) { guarded(k, [&] { encoded[k] = read_image(images[k]); }); });
-  throw_if_cancelled(cancel_);
-  uint64_t kept = 0, largest_transient = 0;
-  const uint64_t budget = limits_.textures.max_total_bytes;
-  for (size_t k = 0; k < images.size(); ++k) {
-    if (!problem[k].empty()) continue;
-    const uint64_t final_bytes = encoded[k].decoded_bytes();
-    const uint64_t transient = encoded[k].decode_peak_bytes() - final_bytes;
-    if (kept + final_bytes + std::max(largest_transient, transient) > budget) {
-      problem[k] = encoded[k].name + ": the scene's textures would take more than " + std::to_string(budget >> 20) +
-                   " MiB to decode (--max-texture-mib raises it)";
-      encoded[k] = {};
-      continue;
-    }
-    kept += final_bytes;
-    largest_transient = std::max(largest_transient, transient);
-  }
-  ByteBudget transients(budget - kept);
-  limits_.for_each(images.size(), [&](size_t k) {
-    if (problem[k].empty()) {
-      const ByteBudget::Taken held(transients, encoded[k].decode_peak_bytes() - encoded[k].decoded_bytes());
-      guarded(k, [&] { decoded[k] = decode_texture(encoded[k]); });
-    }
-    encoded[k] = {};
-  });
-  throw_if_cancelled(cancel_);
+  const TextureBatch batch = read_and_decode(
+      images.size(), [&](size_t k) { return read_image(images[k]); }, limits_, cancel_);
   // Slot -> scene texture (kInvalidIndex where its image failed).
   std::vector<uint32_t> slot_texture(texture_uses_.size(), kInvalidIndex);
   for (size_t s = 0; s < texture_uses_.size(); ++s) {
     const TextureUse& u = texture_uses_[s];
     const size_t k = size_t(std::lower_bound(images.begin(), images.end(), u.image) - images.begin());
-    if (!decoded[k]) continue;
+    if (!batch.decoded[k]) continue;
     slot_texture[s] = uint32_t(scene.textures.size());
-    scene.textures.push_back(u.tint == Vec3{1.0f} ? *decoded[k] : decoded[k]->tinted(u.tint));
+    scene.textures.push_back(u.tint == Vec3{1.0f} ? *batch.decoded[k] : batch.decoded[k]->tinted(u.tint));
   }
   for (size_t k = 0; k < images.size(); ++k) {
-    if (!problem[k].empty()) warnings_.add("texture not used: " + problem[k]);
+    if (!batch.problem[k].empty())
+      warnings_.add("image " + std::to_string(images[k]) + " not used: " + batch.problem[k]);
   }
   for (Material& m : scene.materials) {
     if (m.diffuse_texture != kInvalidIndex) m.diffuse_texture = slot_texture[m.diffuse_texture];

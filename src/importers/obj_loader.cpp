@@ -11,12 +11,12 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "base/byte_budget.hpp"
 #include "base/read_input.hpp"
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
 #include "importers/mtl_parser.hpp"
 #include "importers/obj_parser.hpp"
+#include "importers/texture_batch.hpp"
 #include "importers/warning_log.hpp"
 #include "scene/texture.hpp"
 
@@ -190,49 +190,11 @@ MaterialTextures read_material_textures(std::vector<std::string> texnames, const
       t.file_of[i] = it->second;
     }
   }
-  // 2. Every file read and its header checked, in parallel; 3. the budget decided in file order (so
-  // which texture is left out never depends on threads); 4. the rest decoded in parallel.
-  std::vector<EncodedTexture> encoded(files.size());
-  t.file_problem.resize(files.size());
-  t.decoded.resize(files.size());
-  const auto guarded = [&](size_t k, auto&& work) {
-    try {
-      work();
-    } catch (const InputError& e) {
-      t.file_problem[k] = e.what();
-    }
-  };
-  limits.for_each(files.size(),
-                  [&](size_t k) { guarded(k, [&] { encoded[k] = read_texture(files[k], limits.textures, cancel); }); });
-  throw_if_cancelled(cancel);
-  // The budget holds the decoded textures and, beside them, the largest decode's transient
-  // buffers: decodes then run at once only while their transients fit what is left (ByteBudget),
-  // and one always can, so peak memory stays within the budget (and the encoded files' bytes).
-  const uint64_t budget = limits.textures.max_total_bytes;
-  uint64_t kept = 0, largest_transient = 0;
-  for (size_t k = 0; k < files.size(); ++k) {
-    if (!t.file_problem[k].empty()) continue;
-    const uint64_t final_bytes = encoded[k].decoded_bytes();
-    const uint64_t transient = encoded[k].decode_peak_bytes() - final_bytes;
-    if (kept + final_bytes + std::max(largest_transient, transient) > budget) {
-      t.file_problem[k] = "the scene's textures would take more than " + std::to_string(budget >> 20) +
-                          " MiB to decode (--max-texture-mib raises it)";
-      encoded[k] = {};
-      continue;
-    }
-    kept += final_bytes;
-    largest_transient = std::max(largest_transient, transient);
-  }
-  ByteBudget transients(budget - kept);
-  limits.for_each(files.size(), [&](size_t k) {
-    if (t.file_problem[k].empty()) {
-      const uint64_t transient = encoded[k].decode_peak_bytes() - encoded[k].decoded_bytes();
-      const ByteBudget::Taken held(transients, transient);
-      guarded(k, [&] { t.decoded[k] = decode_texture(encoded[k]); });
-    }
-    encoded[k] = {};  // the encoded bytes are no longer needed
-  });
-  throw_if_cancelled(cancel);
+  // 2-4. Read, budgeted and decoded together (importers/texture_batch.hpp).
+  TextureBatch batch = read_and_decode(
+      files.size(), [&](size_t k) { return read_texture(files[k], limits.textures, cancel); }, limits, cancel);
+  t.file_problem = std::move(batch.problem);
+  t.decoded = std::move(batch.decoded);
   t.texnames = std::move(texnames);
   return t;
 }
