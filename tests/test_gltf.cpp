@@ -304,6 +304,48 @@ TEST(Gltf, BaseColourTexturesAndTheirFactorAreRead) {
   fs::remove_all(dir);
 }
 
+// Each base colour factor on a texture is a tinted copy of it; the copies count against the
+// texture budget, and past it a material takes the untinted image, said once.
+TEST(Gltf, TintedCopiesOfATextureStayWithinTheBudget) {
+  const std::string png = encode_png(Image8{2, 1, {255, 0, 0, 0, 0, 255}});
+  std::string materials, primitives;
+  for (int i = 0; i < 5; ++i) {
+    materials += std::string(i ? ", " : "") + R"({"pbrMetallicRoughness": {"baseColorFactor": [)" +
+                 std::to_string(0.5 + 0.1 * i) + R"(, 1, 1, 1], "metallicFactor": 0,
+                 "baseColorTexture": {"index": 0}}})";
+    primitives += std::string(i ? ", " : "") + R"({"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": )" +
+                  std::to_string(i) + "}";
+  }
+  const std::string data = bytes_of<float>({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1});
+  const std::string json = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [)" +
+                           primitives + R"(]}], "materials": [)" + materials + R"(],
+    "textures": [{"source": 0}], "images": [{"uri": "data:image/png;base64,)" +
+                           base64(png) + R"("}],
+    "buffers": [{"uri": "data:application/octet-stream;base64,)" +
+                           base64(data) + R"(", "byteLength": 60}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}]})";
+  std::vector<std::string> warnings;
+  const auto collect = [&](const std::string& w) { warnings.push_back(w); };
+  Scene s = load_gltf_from_memory(json, "t.gltf", collect);
+  EXPECT_EQ(s.textures.size(), 5u);  // five tints, each its own copy
+  EXPECT_TRUE(warnings.empty());
+  // The 2x1 texture takes 8 bytes decoded and 34 while it decodes: a budget of 34 holds it and
+  // three tinted copies, not five.
+  LoadLimits limits;
+  limits.textures.max_total_bytes = 34;
+  s = load_gltf_from_memory(json, "t.gltf", collect, limits);
+  EXPECT_EQ(s.textures.size(), 4u);  // three tinted, one untinted for the other two
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0],
+            "t.gltf: image 0: base colour factors past the texture budget: the untinted image is used (2 times; the "
+            "first shown)");
+  EXPECT_EQ(s.materials[3].diffuse_texture, s.materials[4].diffuse_texture);
+  EXPECT_EQ(s.textures[s.materials[4].diffuse_texture].texel(0, 0), (Vec3{1.0f, 0.0f, 0.0f}));
+}
+
 TEST(Gltf, ANormalMapTiltsTheShadingNormalInTheTangentFrame) {
   // A triangle in the xy plane, u along +x and v along +y; a normal map texel (x, y, z) in [-1, 1]
   // tilts the normal to normalize(x * scale, y * scale, z) in (dp/du, dp/dv, n).

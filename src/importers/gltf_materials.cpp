@@ -134,14 +134,39 @@ void Materials::attach_textures(Scene& scene) {
   images.erase(std::unique(images.begin(), images.end()), images.end());
   const TextureBatch batch = read_and_decode(
       images.size(), [&](size_t k) { return read_image(images[k]); }, limits_, cancel_);
-  // Slot -> scene texture (kInvalidIndex where its image failed).
+  // Slot -> scene texture (kInvalidIndex where its image failed). An image is stored once
+  // untinted, however many slots read it so; each tinted copy counts against the texture budget
+  // as a decoded image does (a file could otherwise ask for a thousand tints of one large image),
+  // and past it the slot takes the untinted image, with a warning.
+  uint64_t used = 0;
+  for (const std::optional<Texture>& t : batch.decoded) {
+    if (t) used += uint64_t(t->width()) * uint64_t(t->height()) * 4;
+  }
+  std::vector<uint32_t> plain(images.size(), kInvalidIndex);
+  const auto untinted = [&](size_t k) {
+    if (plain[k] == kInvalidIndex) {
+      plain[k] = uint32_t(scene.textures.size());
+      scene.textures.push_back(*batch.decoded[k]);
+    }
+    return plain[k];
+  };
   std::vector<uint32_t> slot_texture(texture_uses_.size(), kInvalidIndex);
   for (size_t s = 0; s < texture_uses_.size(); ++s) {
     const TextureUse& u = texture_uses_[s];
     const size_t k = size_t(std::lower_bound(images.begin(), images.end(), u.image) - images.begin());
     if (!batch.decoded[k]) continue;
-    slot_texture[s] = uint32_t(scene.textures.size());
-    scene.textures.push_back(u.tint == Vec3{1.0f} ? *batch.decoded[k] : batch.decoded[k]->tinted(u.tint));
+    const uint64_t bytes = uint64_t(batch.decoded[k]->width()) * uint64_t(batch.decoded[k]->height()) * 4;
+    if (u.tint == Vec3{1.0f}) {
+      slot_texture[s] = untinted(k);
+    } else if (used + bytes > limits_.textures.max_total_bytes) {
+      warnings_.add("image " + std::to_string(u.image) +
+                    ": base colour factors past the texture budget: the untinted image is used");
+      slot_texture[s] = untinted(k);
+    } else {
+      used += bytes;
+      slot_texture[s] = uint32_t(scene.textures.size());
+      scene.textures.push_back(batch.decoded[k]->tinted(u.tint));
+    }
   }
   for (size_t k = 0; k < images.size(); ++k) {
     if (!batch.problem[k].empty())
