@@ -51,7 +51,9 @@ int cmd_render(const RenderArgs& args) {
   const auto t_render = std::chrono::steady_clock::now();
   const uint64_t work =
       uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
-  ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done);
+  ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done,
+                       adaptive(settings) ? &control.active_pixels : nullptr,
+                       uint64_t(settings.width) * uint64_t(settings.height));
   // Every pass a round of its own: checkpoints, and a complete image after the first on Ctrl-C.
   const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
     return render_round(accel, ctx, passes, setup.sched, control);

@@ -7,8 +7,13 @@
 namespace tracer::driver {
 
 ProgressBar::ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels,
-                         const std::atomic<uint64_t>& rays)
-    : total_(total_pixels), pixels_(pixels), rays_(rays), start_(std::chrono::steady_clock::now()) {
+                         const std::atomic<uint64_t>& rays, const std::atomic<uint64_t>* active, uint64_t image_pixels)
+    : total_(total_pixels),
+      pixels_(pixels),
+      rays_(rays),
+      active_(active),
+      image_pixels_(image_pixels),
+      start_(std::chrono::steady_clock::now()) {
   if (enabled && ::isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
 }
 
@@ -36,11 +41,14 @@ void ProgressBar::run() {
     bar[kWidth] = '\0';
     std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs  %8.2f Mrays/s", bar, frac * 100.0, elapsed, eta,
                  mrays);
+    if (active_ && image_pixels_) {
+      std::fprintf(stderr, "  active %5.1f%%", 100.0 * double(active_->load()) / double(image_pixels_));
+    }
     std::fflush(stderr);
     drawn_ = true;
     if (cv_.wait_for(lock, milliseconds(200), [this] { return stopping_; })) break;
   }
-  if (drawn_) std::fprintf(stderr, "\r%90s\r", "");  // clear the line
+  if (drawn_) std::fprintf(stderr, "\r%105s\r", "");  // clear the line
 }
 
 }  // namespace tracer::driver

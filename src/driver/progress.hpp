@@ -1,4 +1,5 @@
-// A progress line on stderr for long renders: percent, elapsed, ETA, Mrays/s. Shown only when
+// A progress line on stderr for long renders: percent, elapsed, ETA, Mrays/s (and with adaptive
+// sampling the share of pixels still sampled). Shown only when
 // stderr is a terminal and the render has run for over a second; never written to logs or pipes.
 #pragma once
 
@@ -13,8 +14,10 @@ namespace tracer::driver {
 
 class ProgressBar {
  public:
+  // `active` (adaptive sampling): the pixels still taking samples, of `image_pixels`.
   ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels,
-              const std::atomic<uint64_t>& rays);
+              const std::atomic<uint64_t>& rays, const std::atomic<uint64_t>* active = nullptr,
+              uint64_t image_pixels = 0);
   ~ProgressBar() { stop(); }
   void stop();
 
@@ -23,6 +26,8 @@ class ProgressBar {
   uint64_t total_;
   const std::atomic<uint64_t>& pixels_;
   const std::atomic<uint64_t>& rays_;
+  const std::atomic<uint64_t>* active_;
+  uint64_t image_pixels_;
   std::chrono::steady_clock::time_point start_;
   std::mutex mutex_;
   std::condition_variable cv_;

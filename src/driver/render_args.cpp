@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iostream>
 #include <numbers>
+#include <sstream>
 
 #include "base/errors.hpp"
 #include "driver/parse.hpp"
@@ -97,13 +98,20 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--spp", a.spp,
                  "samples per pixel (1-1048576; default " + std::to_string(kDefaultPathSpp) +
                      " for path, 1 through the pixel centre for ao and whitted)");
+  app.add_option("--noise-threshold", a.noise_threshold,
+                 "path: adaptive sampling: a 4x4 block of pixels stops taking samples once each pixel's noise "
+                 "estimate is below this (0-1; default " +
+                     (std::ostringstream() << kDefaultNoiseThreshold).str() + "; 0 gives every pixel --spp samples)");
+  app.add_option("--min-spp", a.min_spp,
+                 "path: adaptive sampling: samples every pixel takes before it may stop (2-1048576; default " +
+                     std::to_string(kDefaultMinSpp) + ")");
   app.add_option(
       "--env", a.env,
       "path, whitted: radiance r,g,b of a uniform environment, or the --env-map's scale (default black, 1,1,1 "
       "with --env-map; white when the scene has no light)");
   app.add_option("--aov", a.aov,
-                 "path: also write these layers of the first hit into the .exr output, for a denoiser: albedo, "
-                 "normal (comma-separated)");
+                 "path: also write these layers into the .exr output: albedo and normal of the first hit (for a "
+                 "denoiser), samples (each pixel's sample count); comma-separated");
   app.add_option("--light-sampling", a.light_sampling,
                  "path: " + names_of<LightSampling>(kLightSamplingNames) +
                      " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
@@ -158,6 +166,8 @@ void validate(const RenderArgs& a) {
   check_range("--ao", s.ao_samples, 0, 4096);
   check_range("--max-depth", s.max_depth, 0, 64);
   if (a.spp) check_range("--spp", *a.spp, 1, 1 << 20);
+  if (a.noise_threshold) check_range_real("--noise-threshold", *a.noise_threshold, 0.0, 1.0);
+  if (a.min_spp) check_range("--min-spp", *a.min_spp, 2, 1 << 20);
   check_range("--frames", a.frames, 1, 1'000'000);
   check_range_real("--orbit", a.orbit, -1e6, 1e6);
   check_range_real("--env-rotation", a.scene.env_rotation, -1e6, 1e6);

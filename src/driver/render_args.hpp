@@ -59,12 +59,14 @@ struct RenderArgs {
   std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
   std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
   std::string light_sampling{name_of<LightSampling>(kLightSamplingNames, RenderSettings{}.light_sampling)};
-  std::optional<int> spp;            // path: samples per pixel (default kDefaultPathSpp)
-  std::string env;                   // path: uniform environment radiance r,g,b
-  std::string aov;                   // path: albedo,normal layers in the EXR
-  std::optional<double> checkpoint;  // path: seconds between rewrites of the output
-  int frames = 1;                    // --frames: an image sequence, the camera orbiting
-  double orbit = 0.0;                // --orbit: degrees the camera turns over the whole sequence
+  std::optional<int> spp;                 // path: samples per pixel (default kDefaultPathSpp)
+  std::string env;                        // path: uniform environment radiance r,g,b
+  std::string aov;                        // path: albedo,normal layers in the EXR
+  std::optional<double> checkpoint;       // path: seconds between rewrites of the output
+  std::optional<double> noise_threshold;  // path: adaptive sampling's (default kDefaultNoiseThreshold)
+  std::optional<int> min_spp;             // path: adaptive sampling's minimum samples per pixel
+  int frames = 1;                         // --frames: an image sequence, the camera orbiting
+  double orbit = 0.0;                     // --orbit: degrees the camera turns over the whole sequence
   std::optional<int> threads;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;

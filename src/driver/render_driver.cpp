@@ -28,6 +28,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     const std::string output = frame_output(seq.output, frame, seq.frames);
     std::optional<Framebuffer> fb, albedo, normal;
     if (options.holds_image) fb.emplace(settings.width, settings.height);
+    if (fb && adaptive(settings)) fb->keep_halves();
     if (options.holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
     if (options.holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
     const Camera cam(frame_camera(camera, frame, seq.frames, seq.orbit_degrees), settings.width, settings.height);
@@ -37,7 +38,17 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     std::vector<ExrLayer> layers;
     if (albedo) layers.push_back({"albedo", &*albedo, {"R", "G", "B"}});
     if (normal) layers.push_back({"normal", &*normal, {"X", "Y", "Z"}});
+    std::optional<Framebuffer> counts;
+    if (fb && seq.aovs.samples) {
+      counts.emplace(settings.width, settings.height);
+      layers.push_back({"samples", &*counts, {"Y", nullptr, nullptr}});
+    }
     const auto write = [&] {
+      if (counts) {
+        for (int y = 0; y < fb->height(); ++y) {
+          for (int x = 0; x < fb->width(); ++x) counts->set(x, y, Vec3{float(fb->samples(x, y))});
+        }
+      }
       const size_t clamped = write_render(output, *fb, settings.exposure, seq.exr, layers);
       if (clamped > 0 && !warned_clamped) {
         warn(output + ": " + std::to_string(clamped) + " pixel values beyond the " +
@@ -56,7 +67,8 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
         if (!fb) return result;
         // A path render stopped after its first pass is a complete image, only noisier.
         // --save-partial: unfinished tiles black, if any tile finished at all.
-        result.samples = fb->min_samples();
+        // (With adaptive sampling the passes finished: pixels that stopped earlier hold fewer.)
+        result.samples = adaptive(settings) ? done : fb->min_samples();
         if (result.samples > 0 || (seq.save_partial && fb->max_samples() > 0)) {
           write();
           result.wrote_partial = true;

@@ -17,9 +17,10 @@
 
 namespace tracer::driver {
 
-// The --aov layers: first-hit albedo and shading normal, for a denoiser.
+// The --aov layers: first-hit albedo and shading normal, for a denoiser; each pixel's sample
+// count (where adaptive sampling stopped).
 struct Aovs {
-  bool albedo = false, normal = false;
+  bool albedo = false, normal = false, samples = false;
 };
 
 struct FrameSequence {

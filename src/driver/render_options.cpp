@@ -14,6 +14,10 @@ RenderSettings settings_for(const RenderArgs& a) {
       parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
   const bool path = s.integrator == Integrator::Path;
   if (a.checkpoint && !path) throw UsageError("--checkpoint: only for --integrator path");
+  if (a.noise_threshold && !path) throw UsageError("--noise-threshold: only for --integrator path");
+  if (a.min_spp && !path) throw UsageError("--min-spp: only for --integrator path");
+  s.noise_threshold = path ? float(a.noise_threshold.value_or(kDefaultNoiseThreshold)) : 0.0f;
+  s.min_spp = a.min_spp.value_or(kDefaultMinSpp);
   for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--env-map", !a.scene.env_map.empty()}}) {
     if (given && s.integrator == Integrator::Ao)
       throw UsageError(std::string(flag) + ": only for --integrator path or whitted");
@@ -69,8 +73,10 @@ Aovs aovs_for(const RenderArgs& a) {
       aovs.albedo = true;
     } else if (name == "normal") {
       aovs.normal = true;
+    } else if (name == "samples") {
+      aovs.samples = true;
     } else {
-      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal)");
+      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal, samples)");
     }
   }
   if (a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {

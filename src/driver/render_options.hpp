@@ -10,6 +10,10 @@ namespace tracer::driver {
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
 inline constexpr int kDefaultPathSpp = 64;
+// Adaptive sampling's noise threshold and minimum samples per pixel when their flags are not
+// given (docs/BENCHMARKS.md, adaptive sampling: how they were chosen).
+inline constexpr double kDefaultNoiseThreshold = 0.01;
+inline constexpr int kDefaultMinSpp = 16;
 // settings_for() plus what depends on the scene: a path render of a scene with no emissive
 // surface and no --env is lit by a uniform white sky as well as any point lights (a point light
 // alone leaves everything it does not see black), and `note` says so.
@@ -20,7 +24,7 @@ AccelOptions accel_options_for(const RenderArgs& args);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);
 ExrPixel exr_pixel_for(const RenderArgs& args);
-// --aov: a comma-separated list of albedo and normal, only for path renders to .exr; throws UsageError.
+// --aov: a comma-separated list of albedo, normal and samples, only for path renders to .exr; throws UsageError.
 Aovs aovs_for(const RenderArgs& args);
 
 }  // namespace tracer::driver

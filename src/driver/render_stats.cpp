@@ -24,34 +24,35 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
                             const RayCounts& rays, const LoadPhases* load_phases, const QueryCounts* traversal) {
   const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
-  nlohmann::json j = {
-      {"scene", scene.source},
-      {"triangles", scene.size()},
-      {"width", settings.width},
-      {"height", settings.height},
-      {"ao_samples", settings.ao_samples},
-      {"accel", accel.name},
-      {"packets", settings.packets},
-      {"sched", name_of<SchedKind>(kSchedKindNames, sched.kind)},
-      {"threads", thread_count(sched)},
-      {"load_ms", load_ms},
-      {"build_ms", accel.build_ms},
-      {"render_ms", render_ms},
-      {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
-      {"max_depth", settings.max_depth},
-      {"spp", settings.spp},
-      {"samples_per_s",
-       render_ms > 0 ? double(settings.width) * settings.height * settings.spp / (render_ms * 1e-3) : 0.0},
-      {"rays",
-       {{"primary", rays.primary},
-        {"shadow", rays.shadow},
-        {"ao", rays.ao},
-        {"secondary", rays.secondary},
-        {"total", rays.total()}}},
-      {"mrays_per_s", mrays},
-      {"accel_bytes", accel.memory_bytes()},
-      {"peak_rss_mib", peak_rss_mib()},
-      {"output", args.output}};
+  nlohmann::json j = {{"scene", scene.source},
+                      {"triangles", scene.size()},
+                      {"width", settings.width},
+                      {"height", settings.height},
+                      {"ao_samples", settings.ao_samples},
+                      {"accel", accel.name},
+                      {"packets", settings.packets},
+                      {"sched", name_of<SchedKind>(kSchedKindNames, sched.kind)},
+                      {"threads", thread_count(sched)},
+                      {"load_ms", load_ms},
+                      {"build_ms", accel.build_ms},
+                      {"render_ms", render_ms},
+                      {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
+                      {"max_depth", settings.max_depth},
+                      {"spp", settings.spp},
+                      // Samples taken: one camera ray each (adaptive sampling skips pixels that have converged).
+                      {"samples_per_s", render_ms > 0 ? double(rays.primary) / (render_ms * 1e-3) : 0.0},
+                      {"noise_threshold", settings.integrator == Integrator::Path ? settings.noise_threshold : 0.0f},
+                      {"min_spp", settings.min_spp},
+                      {"rays",
+                       {{"primary", rays.primary},
+                        {"shadow", rays.shadow},
+                        {"ao", rays.ao},
+                        {"secondary", rays.secondary},
+                        {"total", rays.total()}}},
+                      {"mrays_per_s", mrays},
+                      {"accel_bytes", accel.memory_bytes()},
+                      {"peak_rss_mib", peak_rss_mib()},
+                      {"output", args.output}};
   if (load_phases) {
     j["load_phases_ms"] = {{"read", load_phases->read_ms},
                            {"parse", load_phases->parse_ms},
@@ -76,10 +77,17 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
   const std::string integrator = str("integrator");
   const std::string depth = std::to_string(j["max_depth"].get<int>());
-  const std::string workload = integrator == "ao" ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
-                               : integrator == "whitted" ? "whitted, at most " + depth + " reflections/refractions"
-                                                         : "path, " + std::to_string(j["spp"].get<int>()) +
-                                                               " samples per pixel, at most " + depth + " bounces";
+  std::string workload = integrator == "ao"        ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
+                         : integrator == "whitted" ? "whitted, at most " + depth + " reflections/refractions"
+                                                   : "path, " + std::to_string(j["spp"].get<int>()) +
+                                                         " samples per pixel, at most " + depth + " bounces";
+  if (integrator == "path" && j["noise_threshold"].get<double>() > 0.0) {
+    const double pixels = double(j["width"].get<int>()) * j["height"].get<int>();
+    char adaptive[160];
+    std::snprintf(adaptive, sizeof adaptive, " (adaptive: noise threshold %g, %.1f taken on average)",
+                  j["noise_threshold"].get<double>(), double(j["rays"]["primary"].get<uint64_t>()) / pixels);
+    workload += adaptive;
+  }
   std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
               str("output").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),

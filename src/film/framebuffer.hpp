@@ -32,6 +32,21 @@ class Framebuffer {
     sum_[i] += sum;
     samples_[i] += count;
   }
+  // The same, with the sum of those of the samples in one half of the sample sequence
+  // (in_half() of film/convergence.hpp): kept only after keep_halves(), for adaptive sampling's
+  // noise estimate.
+  void add(int x, int y, Vec3 sum, Vec3 half_sum, uint32_t count) {
+    const size_t i = index(x, y);
+    sum_[i] += sum;
+    samples_[i] += count;
+    if (!half_.empty()) half_[i] += half_sum;
+  }
+  // From now on also sums each pixel's samples of one half apart (zero so far).
+  void keep_halves() { half_.assign(sum_.size(), Vec3{0.0f}); }
+  bool has_halves() const { return !half_.empty(); }
+  Vec3 sum(int x, int y) const { return sum_[index(x, y)]; }
+  Vec3 half_sum(int x, int y) const { return half_.empty() ? Vec3{0.0f} : half_[index(x, y)]; }
+  uint32_t samples(int x, int y) const { return samples_[index(x, y)]; }
   // Makes (x, y) hold exactly `value`, as one sample (an image read back, a test's pattern).
   void set(int x, int y, Vec3 value) {
     const size_t i = index(x, y);
@@ -54,11 +69,13 @@ class Framebuffer {
       for (int x = tile.x0; x < tile.x1; ++x) {
         sum_[index(x, y)] = from.sum_[from.index(x, y)];
         samples_[index(x, y)] = from.samples_[from.index(x, y)];
+        if (!half_.empty()) half_[index(x, y)] = from.half_sum(x, y);
       }
     }
   }
   // Raw sums by pixel index (row-major), for sending a window's pixels to another rank.
   const Vec3* sums() const { return sum_.data(); }
+  const Vec3* half_sums() const { return half_.data(); }  // only with has_halves()
 
  private:
   size_t index(int x, int y) const { return size_t(y - y0_) * size_t(width_) + size_t(x - x0_); }
@@ -66,6 +83,7 @@ class Framebuffer {
   int x0_ = 0, y0_ = 0;
   std::vector<Vec3> sum_;
   std::vector<uint32_t> samples_;
+  std::vector<Vec3> half_;  // empty unless keep_halves()
 };
 
 }  // namespace tracer

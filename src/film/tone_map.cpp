@@ -8,13 +8,16 @@ namespace tracer {
 namespace {
 
 uint8_t encode(float linear, float exposure) {
-  if (!(linear > 0.0f)) return 0;  // also maps NaN to black
-  const float mapped = 1.0f - std::exp(-exposure * linear);
-  const float srgb = mapped <= 0.0031308f ? 12.92f * mapped : 1.055f * std::pow(mapped, 1.0f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::clamp(std::lround(srgb * 255.0f), 0L, 255L));
+  return static_cast<uint8_t>(std::clamp(std::lround(display_value(linear, exposure) * 255.0f), 0L, 255L));
 }
 
 }  // namespace
+
+float display_value(float linear, float exposure) {
+  if (!(linear > 0.0f)) return 0.0f;  // also maps NaN to black
+  const float mapped = 1.0f - std::exp(-exposure * linear);
+  return mapped <= 0.0031308f ? 12.92f * mapped : 1.055f * std::pow(mapped, 1.0f / 2.4f) - 0.055f;
+}
 
 Image8 tonemap(const Framebuffer& fb, float exposure) {
   Image8 img;

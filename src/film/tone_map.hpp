@@ -14,8 +14,11 @@ struct Image8 {
   std::vector<uint8_t> rgb;
 };
 
-// Exponential tone map 1 - exp(-exposure * L) of each pixel's radiance, then the sRGB transfer
-// curve, rounded to 8 bits.
+// One channel of linear radiance as displayed, in [0, 1]: the exponential tone map
+// 1 - exp(-exposure * L), then the sRGB transfer curve (NaN and negatives: 0).
+float display_value(float linear, float exposure);
+
+// display_value() of each channel of each pixel's radiance, rounded to 8 bits.
 Image8 tonemap(const Framebuffer& fb, float exposure);
 
 // Tone-maps the pixels of `tile` into `image` (of fb's size), as tonemap() maps them.

@@ -47,6 +47,7 @@ void add_channels(Imf::Header& header, Imf::FrameBuffer& frame, std::vector<T>& 
                   const std::array<const char*, 3>& names = {"R", "G", "B"}) {
   const size_t n = size_t(w) * size_t(h);
   for (int c = 0; c < 3; ++c) {
+    if (!names[c]) continue;  // a layer of fewer channels
     const std::string name = prefix.empty() ? std::string(names[c]) : prefix + "." + names[c];
     header.channels().insert(name, Imf::Channel(type));
     frame.insert(name, Imf::Slice(type, reinterpret_cast<char*>(planes.data() + size_t(c) * n), sizeof(T),
@@ -166,6 +167,7 @@ Framebuffer decode_exr(std::string_view bytes, const std::string& path, const Ex
     const auto [w, h] = window_size(file.header(), path);
     const Imath::Box2i window = file.header().dataWindow();
     for (int c = 0; c < 3; ++c) {
+      if (!layer.channels[c]) continue;
       const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
       if (!file.header().channels().findChannel(name)) throw InputError(path + ": no channel " + name);
     }
@@ -174,6 +176,7 @@ Framebuffer decode_exr(std::string_view bytes, const std::string& path, const Ex
     std::vector<float> planes(3 * size_t(w) * size_t(h));
     Imf::FrameBuffer frame;
     for (int c = 0; c < 3; ++c) {
+      if (!layer.channels[c]) continue;  // left 0
       const std::string name = layer.name.empty() ? layer.channels[c] : layer.name + "." + layer.channels[c];
       char* base = reinterpret_cast<char*>(planes.data() + size_t(c) * size_t(w) * size_t(h));
       base -= (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));

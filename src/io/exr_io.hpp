@@ -20,6 +20,7 @@ inline constexpr EnumName<ExrPixel> kExrPixelNames[] = {{ExrPixel::Half, "half"}
 struct ExrLayer {
   std::string name;
   const Framebuffer* image = nullptr;
+  // The channels of the image's x, y, z; a null name leaves that one out (read back as 0).
   std::array<const char*, 3> channels{"R", "G", "B"};
 };
 

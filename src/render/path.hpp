@@ -166,8 +166,9 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
   const RenderSettings& s = ctx.settings;
   for (int y = tile.y0; y < tile.y1; ++y) {
     for (int x = tile.x0; x < tile.x1; ++x) {
+      if (ctx.active && !ctx.active->active(x, y)) continue;
       const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
-      Vec3 sum{0.0f}, albedo{0.0f}, normal{0.0f};
+      Vec3 sum{0.0f}, half{0.0f}, albedo{0.0f}, normal{0.0f};
       const bool aovs = ctx.albedo || ctx.normal;
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const PixelSampler sampler(pixel, k, s.seed);
@@ -182,11 +183,14 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
         ++counts.primary;
         FirstHit first;
         const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr);
-        if (is_finite(l)) sum += l;
+        if (is_finite(l)) {
+          sum += l;
+          if (in_half(k)) half += l;
+        }
         albedo += first.albedo;
         normal += first.normal;
       }
-      ctx.framebuffer->add(x, y, sum, ctx.samples.count);
+      ctx.framebuffer->add(x, y, sum, half, ctx.samples.count);
       if (ctx.albedo) ctx.albedo->add(x, y, albedo, ctx.samples.count);
       if (ctx.normal) ctx.normal->add(x, y, normal, ctx.samples.count);
     }

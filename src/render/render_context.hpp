@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "film/convergence.hpp"
 #include "film/framebuffer.hpp"
 #include "render/ray_counts.hpp"
 #include "render/render_settings.hpp"
@@ -28,6 +29,8 @@ struct RenderContext {
   // denoiser), summed and counted as the radiance is; null when not asked for.
   Framebuffer* albedo = nullptr;
   Framebuffer* normal = nullptr;
+  // path with adaptive sampling: the pixels this pass samples (null: all of them).
+  const ActivePixels* active = nullptr;
 };
 
 }  // namespace tracer

@@ -5,8 +5,27 @@
 
 namespace tracer {
 
-bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
+NoiseTarget noise_target(const RenderSettings& s) {
+  if (s.integrator != Integrator::Path) return {};
+  return {s.noise_threshold, uint32_t(std::max(s.min_spp, 2)), s.exposure};
+}
+
+void choose_active_pixels(RenderContext& ctx, RenderControl& control) {
+  const NoiseTarget target = noise_target(ctx.settings);
+  if (target.threshold <= 0.0f) return;
+  if (ctx.samples.first < target.min_samples) {
+    control.active_pixels.store(ctx.framebuffer->pixel_count(), std::memory_order_relaxed);
+    return;
+  }
+  control.active.update(*ctx.framebuffer, target);
+  control.active_pixels.store(control.active.active_pixels(), std::memory_order_relaxed);
+  ctx.active = &control.active;
+}
+
+bool render_image(const Accelerator& accel, const RenderContext& image, const SchedOptions& options,
                   RenderControl& control) {
+  RenderContext ctx = image;
+  choose_active_pixels(ctx, control);
   return parallel_for_tiles(
       ctx.framebuffer->width(), ctx.framebuffer->height(), options, control.cancel, [&](const Tile& tile) {
         // The one place the accelerator variant is dispatched: once per tile, which is walked in
@@ -49,7 +68,8 @@ std::vector<SampleRange> sample_passes(const RenderSettings& settings) {
   std::vector<SampleRange> passes;
   const uint32_t total = uint32_t(std::max(settings.spp, 1));
   for (uint32_t done = 0; done < total;) {
-    const uint32_t count = std::min({total - done, std::max(done, 1u), kMaxPassSamples});
+    const uint32_t count =
+        std::min({total - done, std::max(done, 1u), adaptive(settings) ? kAdaptivePassSamples : kMaxPassSamples});
     passes.push_back({done, count});
     done += count;
   }

@@ -23,6 +23,10 @@ struct RenderControl {
   AtomicRayCounts counts;
   AtomicQueryCounts traversal;               // with settings.count_traversal, where the accelerator counts
   std::function<void(const Tile&)> on_tile;  // test hook, called once per rendered tile
+  // Adaptive sampling: the pixels the current pass samples, decided before it from the film, and
+  // their count (for the progress line).
+  ActivePixels active;
+  std::atomic<uint64_t> active_pixels{0};
   bool cancelled() const { return is_cancelled(cancel); }
 };
 
@@ -33,9 +37,20 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
 
 // The passes of a render: settings.spp samples per pixel (ao and whitted: 1 by default) in
 // passes that double (1, 1, 2, 4, ... at most kMaxPassSamples), so a checkpoint or a stop finds
-// a complete image early and later passes keep the tile overhead small.
+// a complete image early and later passes keep the tile overhead small. With adaptive sampling
+// at most kAdaptivePassSamples, the samples between two decisions of which pixels go on.
 inline constexpr uint32_t kMaxPassSamples = 64;
+inline constexpr uint32_t kAdaptivePassSamples = 8;
 std::vector<SampleRange> sample_passes(const RenderSettings& settings);
+
+// Adaptive sampling's target for these settings: threshold 0 (off) but for path tracing.
+NoiseTarget noise_target(const RenderSettings& settings);
+inline bool adaptive(const RenderSettings& settings) { return noise_target(settings).threshold > 0.0f; }
+
+// Before a pass of ctx.samples with adaptive sampling: decides from ctx.framebuffer (kept with
+// halves) which pixels the pass samples, into `control`, and points ctx.active at them. Does
+// nothing without adaptive sampling or before the minimum samples.
+void choose_active_pixels(RenderContext& ctx, RenderControl& control);
 
 // The passes of `round` (some of sample_passes(), in order) of every pixel into ctx.framebuffer,
 // each by render_image(): what tracer render does with each round of the render driver. Returns

@@ -36,6 +36,10 @@ struct RenderSettings {
   int spp = 1;             // samples per pixel (every integrator)
   Vec3 environment{0.0f};  // path: radiance arriving from every direction no surface blocks
   LightSampling light_sampling = LightSampling::Mis;
+  // path: adaptive sampling (film/convergence.hpp): a 4x4 block of pixels stops taking samples
+  // once each has min_spp and a noise estimate below this; 0 gives every pixel spp samples.
+  float noise_threshold = 0.0f;
+  int min_spp = 16;
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
