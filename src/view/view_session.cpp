@@ -226,7 +226,9 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     const bool same_view = a.eye == args_.eye && a.look == args_.look && a.up == args_.up && a.fov == args_.fov &&
                            a.aperture == args_.aperture && a.focus_distance == args_.focus_distance &&
                            a.integrator == args_.integrator && a.settings.max_depth == args_.settings.max_depth &&
-                           a.settings.width == args_.settings.width && a.settings.height == args_.settings.height;
+                           a.settings.width == args_.settings.width && a.settings.height == args_.settings.height &&
+                           // adaptive sampling measures noise at the exposure: another one stops other pixels
+                           (!adaptive(settings) || settings.exposure == job_.settings.exposure);
     const bool restart = !same_view || a.spp != args_.spp;
     const bool raised = same_view && *a.spp > *args_.spp;
     args_ = a;
@@ -394,6 +396,7 @@ bool ViewSession::render_job(const Job& job) {
       }
     }
     film_.emplace(s.width, s.height);
+    if (adaptive(s)) film_->keep_halves();
     film_done_ = 0;
   } else {
     const std::lock_guard lock(display_mu_);
@@ -406,7 +409,6 @@ bool ViewSession::render_job(const Job& job) {
   RenderControl control;
   const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
   const auto t_start = Clock::now();
-  const uint32_t resumed_at = film_done_;
   size_t tiles_done = 0;
   for (size_t p = first_pass; p < passes.size(); ++p) {
     ctx.samples = passes[p];
@@ -451,7 +453,7 @@ bool ViewSession::render_job(const Job& job) {
       pass_fraction_ = 0.0;
       last_pass_ms_ = pass_seconds * 1e3;
       accum_seconds_ = seconds_since(t_start);
-      accum_samples_ = uint64_t(fb.pixel_count()) * (film_done_ - resumed_at);
+      accum_samples_ = control.counts.load().primary;  // samples taken: adaptive sampling skips some pixels
       accum_rays_ = control.rays_done.load();
     }
     publish_display(true);
