@@ -113,6 +113,30 @@ TEST_F(MpiRender, SameImageAsOneProcessForAnyRanksThreadsAndTiles) {
   }
 }
 
+TEST_F(MpiRender, AdaptiveSamplingStopsTheSamePixelsAsOneProcess) {
+  // Rank 0 decides between passes from its image and sends each tile's blocks with the tile;
+  // the workers send back their halves' sums too. Same floats as one process, and fewer samples
+  // than every pixel's (blocks did stop).
+  const std::string common =
+      " --integrator path --spp 40 --min-spp 8 --noise-threshold 0.05 --width 40 --height 30 -q --exr float";
+  const auto r = test::run_tracer("render" + common + " -o " + dir_ + "/ref.exr --stats-json " + dir_ + "/one.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream one(dir_ + "/one.json");
+  const uint64_t primary = nlohmann::json::parse(one)["rays"]["primary"].get<uint64_t>();
+  EXPECT_LT(primary, 40u * 30u * 40u);
+  EXPECT_GT(primary, 40u * 30u * 8u);
+  for (const auto& [ranks, flags] :
+       {std::pair{2, " --threads 1 --tile 7"}, {3, " --threads 2 --tile 5 --sched queue"}}) {
+    SCOPED_TRACE(std::to_string(ranks) + flags);
+    const auto m = run(mpirun(ranks) + kMpiExe + " render" + common + flags + " -o " + dir_ + "/mpi.exr --stats-json " +
+                       dir_ + "/mpi.json");
+    ASSERT_EQ(m.exit_code, 0) << m.output;
+    EXPECT_TRUE(same_bytes(read_file(dir_ + "/mpi.exr"), read_file(dir_ + "/ref.exr")));
+    std::ifstream in(dir_ + "/mpi.json");
+    EXPECT_EQ(nlohmann::json::parse(in)["rays"]["primary"].get<uint64_t>(), primary);
+  }
+}
+
 TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
   const std::string common = " --integrator path --spp 2 --width 24 --height 18 -q --frames 3 --orbit 120 -o ";
   const auto r = test::run_tracer("render" + common + dir_ + "/one.png");
@@ -127,13 +151,15 @@ TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
 
 TEST_F(MpiRender, EveryTileIsHandedOutExactlyOnce) {
   // 50x20 in 8-pixel tiles: 7 x 3 = 21 tiles; 8 spp runs in passes of 1, 1, 2, 4. Without
-  // --checkpoint each tile is rendered whole, in one round; with it, one round per pass.
-  for (const bool progressive : {false, true}) {
-    SCOPED_TRACE(progressive ? "--checkpoint" : "whole tiles");
+  // --checkpoint or adaptive sampling each tile is rendered whole, in one round; with either,
+  // one round per pass (adaptive sampling, on by default, decides between passes).
+  for (const char* mode : {" --noise-threshold 0", " --noise-threshold 0 --checkpoint 1000", ""}) {
+    SCOPED_TRACE(mode);
+    const bool progressive = std::string(mode) != " --noise-threshold 0";
     const std::string json = dir_ + "/stats.json";
     const auto m = run(mpirun(3) + kMpiExe +
                        " render --integrator path --spp 8 --width 50 --height 20 --tile 8 --threads 2 -q -o " + dir_ +
-                       "/x.png --stats-json " + json + (progressive ? " --checkpoint 1000" : ""));
+                       "/x.png --stats-json " + json + mode);
     ASSERT_EQ(m.exit_code, 0) << m.output;
     std::ifstream in(json);
     const nlohmann::json j = nlohmann::json::parse(in);

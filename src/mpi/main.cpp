@@ -61,7 +61,10 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
                                      false};
   const driver::DriveResult driven = driver::drive_render(
       prepared.scene, prepared.camera, prepared.settings, frames,
-      {.holds_image = session.root(), .round_per_pass = args.checkpoint.has_value(), .cancel = nullptr},
+      // Adaptive sampling decides between passes, from rank 0's image: a round per pass.
+      {.holds_image = session.root(),
+       .round_per_pass = args.checkpoint.has_value() || adaptive(prepared.settings),
+       .cancel = nullptr},
       [&](const RenderContext& ctx, const std::vector<SampleRange>& round) { return rank.render_round(ctx, round); },
       [](const std::string& w) { say("tracer-mpi: warning: " + w); });
   rank.report_late_ranks();

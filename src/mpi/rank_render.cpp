@@ -73,17 +73,26 @@ double RankRender::answer_bound() const { return 2.0 * std::max(rank_timeout_, 8
 bool RankRender::render_round(const RenderContext& ctx, const std::vector<SampleRange>& round) {
   ++round_serial_;
   const uint32_t samples = round.back().first + round.back().count - round.front().first;
+  // Adaptive sampling (a round per pass then): every rank knows whether this pass decides which
+  // pixels it samples; rank 0 decides from its image and sends each tile's part with the tile.
+  const NoiseTarget target = noise_target(ctx.settings);
+  const bool masks = target.threshold > 0.0f && round.front().first >= target.min_samples;
   if (session_.root()) {
-    serve_round(ctx, round, samples);
+    RenderContext c = ctx;
+    if (masks) {
+      active_.update(*ctx.framebuffer, target);
+      c.active = &active_;
+    }
+    serve_round(c, round, samples);
   } else {
-    work_round(ctx, round, samples);
+    work_round(ctx, round, samples, masks);
   }
   return true;
 }
 
 void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples) {
   Framebuffer& fb = *ctx.framebuffer;
-  TileServer server(tiles_, threads_, round_serial_, watch_);
+  TileServer server(tiles_, threads_, round_serial_, watch_, ctx.active);
   std::exception_ptr own_failure;
   std::thread own([&] {
     try {
@@ -98,6 +107,7 @@ void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleR
             }
             // Taken back from a late rank: its copy may still come, so render apart.
             Framebuffer window(t);
+            if (fb.has_halves()) window.keep_halves();
             count(render_one(setup_.accel, ctx, round, window, t), t, samples);
             server.commit(g.tile, window, fb, samples);
           });
@@ -121,8 +131,9 @@ void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleR
   for (size_t r = 0; r < given.size(); ++r) tiles_per_rank_[r] += given[r];
 }
 
-void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples) {
-  TileClient client(tiles_, round_serial_);
+void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples,
+                            bool masks) {
+  TileClient client(tiles_, round_serial_, masks);
   // Rank 0 answers a request at once, or, between rounds, once the round is in.
   watch_phase_.arm("tracer-mpi: error: rank " + std::to_string(session_.rank()) + " of " +
                        std::to_string(session_.size()) + ": rank 0 stopped answering (no answer within " +
@@ -136,12 +147,17 @@ void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRa
       TileClient::Worker worker(client, thread_ids.fetch_add(1));
       std::optional<uint32_t> finished;
       std::unique_ptr<Framebuffer> result;
+      ActivePixels active;  // this thread's tiles' blocks
+      RenderContext c = ctx;
+      if (masks) c.active = &active;
       double idle = 0;
       while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
         const Tile& t = tiles_[*next];
         result = std::make_unique<Framebuffer>(t);
+        if (adaptive(ctx.settings)) result->keep_halves();
+        if (masks) active.set_window_blocks(ctx.settings.width, ctx.settings.height, t, worker.mask());
         const auto t0 = Clock::now();
-        count(render_one(setup_.accel, ctx, round, *result, t), t, samples);
+        count(render_one(setup_.accel, c, round, *result, t), t, samples);
         const double took = ms_since(t0) * 1e-3;
         for (double seen = slowest_tile_s_.load(); took > seen && !slowest_tile_s_.compare_exchange_weak(seen, took);) {
         }

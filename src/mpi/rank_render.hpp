@@ -37,7 +37,8 @@ class RankRender {
 
  private:
   void serve_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples);
-  void work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples);
+  // `masks`: rank 0 sends the blocks of adaptive sampling's active pixels with each tile.
+  void work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples, bool masks);
   void count(const RayCounts& c, const Tile& t, uint32_t samples);
   // How long a worker waits on rank 0 before taking it for stopped: twice the time rank 0 gives a
   // late rank (overdue_after()) and the rendering of that rank's tiles.
@@ -57,6 +58,7 @@ class RankRender {
   std::atomic<uint64_t> pixels_done_{0}, rays_done_{0};
   std::optional<driver::ProgressBar> progress_;  // rank 0's, reading the two above
   std::atomic<double> slowest_tile_s_{0.0};      // this rank's slowest tile so far
+  ActivePixels active_;                          // rank 0, adaptive sampling: this pass's pixels
   std::mutex idle_mutex_;
   double idle_ms_ = 0;                    // this rank's threads waiting for tiles
   double server_ms_ = 0;                  // rank 0: time spent on messages (requests, returned tiles, done)

@@ -11,12 +11,14 @@ namespace {
 
 // Kinds of message within a pass (see pass_tag()).
 constexpr int kRequest = 0;  // int32 {thread}: send me a tile
-constexpr int kResult = 1;   // int32 tile, then its pixels' sums (three floats each, row by row)
+constexpr int kResult = 1;   // int32 tile, then its pixels' sums (three floats each, row by row), then
+                             // with adaptive sampling their halves' sums (as many again)
 constexpr int kDone = 2;     // int32 {thread}: this thread has sent everything, the pass is over for it
 constexpr int kKinds = 3;
 constexpr uint32_t kPassSlots = 4096;  // tags repeat after this many passes; far apart by then
 constexpr int kTagFailure = 1;         // a rank's error message, whenever it happens
-constexpr int kTagAnswer = 16;         // + thread: rank 0's answer, a tile index or -1 when none is left
+constexpr int kTagAnswer = 16;         // + thread: rank 0's answer, a tile index or -1 when none is left,
+                                       // with masks then the tile's blocks (ActivePixels::window_blocks)
 constexpr int kTagPassBase = 2048;     // above every answer tag (threads are at most 1024); the
                                        // largest tag, 2048 + 3 * 4096, is within the 32767 MPI promises
 
@@ -42,11 +44,12 @@ class Backoff {
 int pass_tag(uint32_t serial, int kind) { return kTagPassBase + int(serial % kPassSlots) * kKinds + kind; }
 
 TileServer::TileServer(const std::vector<Tile>& tiles, const std::vector<uint64_t>& rank_threads, uint32_t pass_serial,
-                       StallWatch& watch)
+                       StallWatch& watch, const ActivePixels* active)
     : tiles_(tiles),
       rank_threads_(rank_threads),
       serial_(pass_serial),
       watch_(watch),
+      active_(active),
       owner_(tiles.size(), 0),
       handed_(tiles.size()),
       in_(tiles.size(), 0),
@@ -92,16 +95,17 @@ void TileServer::own_done(uint32_t t) {
   if (!in_[t]) received(t);
 }
 
+void TileServer::add_pixel(Framebuffer& fb, int x, int y, Vec3 sum, Vec3 half, uint32_t samples) const {
+  fb.add(x, y, sum, half, active_ && !active_->active(x, y) ? 0u : samples);
+}
+
 void TileServer::commit(uint32_t t, const Framebuffer& window, Framebuffer& fb, uint32_t samples) {
   // Under the mutex, as serve() adds the tiles other ranks return: one copy of a tile counts.
   const std::lock_guard lock(mutex_);
   if (in_[t]) return;
   const Tile& tile = tiles_[t];
-  const Vec3* sums = window.sums();
   for (int y = tile.y0; y < tile.y1; ++y) {
-    for (int x = tile.x0; x < tile.x1; ++x) {
-      fb.add(x, y, sums[size_t(y - tile.y0) * size_t(tile.x1 - tile.x0) + size_t(x - tile.x0)], samples);
-    }
+    for (int x = tile.x0; x < tile.x1; ++x) add_pixel(fb, x, y, window.sum(x, y), window.half_sum(x, y), samples);
   }
   received(t);
 }
@@ -120,7 +124,7 @@ void TileServer::check_overdue(std::chrono::steady_clock::time_point now) {
 }
 
 void TileServer::serve(Framebuffer& fb, uint32_t samples) {
-  std::vector<char> buffer;
+  std::vector<char> buffer, answer_bytes;
   Backoff backoff;
   using Clock = std::chrono::steady_clock;
   auto last_check = Clock::now();
@@ -193,21 +197,33 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
             handed_[size_t(answer)] = Clock::now();
             ++tiles_per_rank_[source];
           }
-          MPI_Send(&answer, 1, MPI_INT32_T, status.MPI_SOURCE, kTagAnswer + first, MPI_COMM_WORLD);
+          // The worker's receive is posted before its request is sent, so this send never waits
+          // on it, masks included.
+          answer_bytes.assign(reinterpret_cast<const char*>(&answer),
+                              reinterpret_cast<const char*>(&answer) + sizeof answer);
+          if (active_ && answer >= 0) {
+            const std::vector<uint8_t> mask = active_->window_blocks(tiles_[size_t(answer)]);
+            answer_bytes.insert(answer_bytes.end(), mask.begin(), mask.end());
+          }
+          MPI_Send(answer_bytes.data(), int(answer_bytes.size()), MPI_BYTE, status.MPI_SOURCE, kTagAnswer + first,
+                   MPI_COMM_WORLD);
           break;
         }
         case kResult: {
           // The first copy of a tile counts; a late rank's copy of a reissued tile is dropped.
           if (first < 0 || size_t(first) >= tiles_.size() || in_[size_t(first)]) break;
           const Tile& t = tiles_[size_t(first)];
-          if (size_t(bytes) != sizeof first + size_t(t.pixel_count()) * 3 * sizeof(float)) break;
+          const size_t plane = size_t(t.pixel_count()) * 3 * sizeof(float);
+          const bool halves = fb.has_halves();
+          if (size_t(bytes) != sizeof first + plane * (halves ? 2 : 1)) break;
           const char* p = buffer.data() + sizeof first;
           for (int y = t.y0; y < t.y1; ++y) {
             for (int x = t.x0; x < t.x1; ++x) {
-              float c[3];
+              float c[3], h[3] = {0.0f, 0.0f, 0.0f};
               std::memcpy(c, p, sizeof c);
+              if (halves) std::memcpy(h, p + plane, sizeof h);
               p += sizeof c;
-              fb.add(x, y, Vec3{c[0], c[1], c[2]}, samples);
+              add_pixel(fb, x, y, Vec3{c[0], c[1], c[2]}, Vec3{h[0], h[1], h[2]}, samples);
             }
           }
           received(uint32_t(first));
@@ -236,7 +252,15 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
   }
 }
 
-TileClient::Worker::Worker(TileClient& client, int thread) : client_(client), thread_(thread) {}
+TileClient::TileClient(const std::vector<Tile>& tiles, uint32_t pass_serial, bool masks)
+    : tiles_(tiles), serial_(pass_serial) {
+  for (const Tile& t : tiles) {
+    answer_bytes_ = std::max(answer_bytes_, sizeof(int32_t) + (masks ? ActivePixels::window_block_count(t) : 0));
+  }
+}
+
+TileClient::Worker::Worker(TileClient& client, int thread)
+    : client_(client), thread_(thread), answer_(client.answer_bytes_) {}
 
 TileClient::Worker::~Worker() {
   // Normally nothing is outstanding here; after an error, give up what is.
@@ -256,7 +280,7 @@ void TileClient::Worker::post_request() {
   std::lock_guard lock(client_.mutex_);
   if (request_send_ != MPI_REQUEST_NULL) MPI_Wait(&request_send_, MPI_STATUS_IGNORE);  // 8 bytes: long sent
   request_[0] = thread_;
-  MPI_Irecv(&answer_, 1, MPI_INT32_T, 0, kTagAnswer + thread_, MPI_COMM_WORLD, &answer_recv_);
+  MPI_Irecv(answer_.data(), int(answer_.size()), MPI_BYTE, 0, kTagAnswer + thread_, MPI_COMM_WORLD, &answer_recv_);
   MPI_Isend(request_, 2, MPI_INT32_T, 0, pass_tag(client_.serial_, kRequest), MPI_COMM_WORLD, &request_send_);
 }
 
@@ -277,7 +301,9 @@ int32_t TileClient::Worker::wait_answer(double& idle_ms) {
   const auto t0 = std::chrono::steady_clock::now();
   complete(answer_recv_);
   idle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return answer_;
+  int32_t tile = -1;
+  std::memcpy(&tile, answer_.data(), sizeof tile);
+  return tile;
 }
 
 void TileClient::Worker::wait_send() { complete(result_send_); }
@@ -293,11 +319,14 @@ std::optional<uint32_t> TileClient::Worker::next(std::optional<uint32_t> finishe
     const Tile& t = client_.tiles_[*finished];
     const int32_t index = int32_t(*finished);
     result_.assign(reinterpret_cast<const char*>(&index), reinterpret_cast<const char*>(&index) + sizeof index);
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const Vec3& v = sums->sums()[size_t(y - t.y0) * size_t(t.x1 - t.x0) + size_t(x - t.x0)];
-        const float c[3] = {v.x, v.y, v.z};
-        result_.insert(result_.end(), reinterpret_cast<const char*>(c), reinterpret_cast<const char*>(c) + sizeof c);
+    for (const Vec3* plane : {sums->sums(), sums->has_halves() ? sums->half_sums() : nullptr}) {
+      if (!plane) continue;  // no halves without adaptive sampling
+      for (int y = t.y0; y < t.y1; ++y) {
+        for (int x = t.x0; x < t.x1; ++x) {
+          const Vec3& v = plane[size_t(y - t.y0) * size_t(t.x1 - t.x0) + size_t(x - t.x0)];
+          const float c[3] = {v.x, v.y, v.z};
+          result_.insert(result_.end(), reinterpret_cast<const char*>(c), reinterpret_cast<const char*>(c) + sizeof c);
+        }
       }
     }
     std::lock_guard lock(client_.mutex_);

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "film/convergence.hpp"
 #include "film/framebuffer.hpp"
 #include "parallel/tiles.hpp"
 
@@ -62,8 +63,10 @@ class TileServer {
  public:
   // `rank_threads[r]`: the render threads of rank r (rank 0's own not counted); each says when it
   // is done. `watch` carries what earlier passes learnt and learns from this one.
+  // `active` (adaptive sampling, when this pass has decided): the pixels it samples, whose
+  // blocks go with each tile handed out; the others take no samples.
   TileServer(const std::vector<Tile>& tiles, const std::vector<uint64_t>& rank_threads, uint32_t pass_serial,
-             StallWatch& watch);
+             StallWatch& watch, const ActivePixels* active = nullptr);
   // The next tile for one of rank 0's own threads, or nothing when every tile of the pass is in;
   // waits while tiles are out with other ranks (one may be taken back). Thread-safe.
   std::optional<TileGrant> take();
@@ -85,6 +88,8 @@ class TileServer {
  private:
   // Called under mutex_: marks tile t in (its sums added), and notes how long it was out.
   void received(uint32_t t);
+  // Called under mutex_: adds one pixel's sums (and its half's) for the samples it took.
+  void add_pixel(Framebuffer& fb, int x, int y, Vec3 sum, Vec3 half, uint32_t samples) const;
   // Called under mutex_: ranks holding overdue tiles become late, their tiles reissued.
   void check_overdue(std::chrono::steady_clock::time_point now);
 
@@ -92,6 +97,7 @@ class TileServer {
   std::vector<uint64_t> rank_threads_;
   uint32_t serial_;
   StallWatch& watch_;
+  const ActivePixels* active_;
   std::mutex mutex_;
   uint32_t next_ = 0;                                          // the next fresh tile
   std::vector<int> owner_;                                     // per tile: the rank it was last handed to
@@ -110,7 +116,8 @@ class TileServer {
 // mutex, never held while waiting).
 class TileClient {
  public:
-  TileClient(const std::vector<Tile>& tiles, uint32_t pass_serial) : tiles_(tiles), serial_(pass_serial) {}
+  // `masks`: rank 0 sends each tile's blocks of adaptive sampling's active pixels with it.
+  TileClient(const std::vector<Tile>& tiles, uint32_t pass_serial, bool masks);
 
   // One render thread's conversation with rank 0; `thread` numbers it within the rank.
   class Worker {
@@ -121,6 +128,8 @@ class TileClient {
     // has told rank 0). Sends `finished`'s sums first, if given. `idle_ms` gets the time spent
     // waiting for a tile.
     std::optional<uint32_t> next(std::optional<uint32_t> finished, const Framebuffer* sums, double& idle_ms);
+    // With masks: the blocks of the tile next() returned (ActivePixels::window_blocks()).
+    const uint8_t* mask() const { return reinterpret_cast<const uint8_t*>(answer_.data() + sizeof(int32_t)); }
 
    private:
     void post_request();
@@ -132,7 +141,8 @@ class TileClient {
     int thread_;
     bool started_ = false;
     MPI_Request request_send_ = MPI_REQUEST_NULL, answer_recv_ = MPI_REQUEST_NULL, result_send_ = MPI_REQUEST_NULL;
-    int32_t request_[2] = {0, 0}, answer_ = -1;
+    int32_t request_[2] = {0, 0};
+    std::vector<char> answer_;  // int32 tile (-1: none left), then with masks the tile's blocks
     std::vector<char> result_;
   };
 
@@ -142,6 +152,7 @@ class TileClient {
  private:
   const std::vector<Tile>& tiles_;
   uint32_t serial_;
+  size_t answer_bytes_ = sizeof(int32_t);  // the largest answer: a tile and its blocks
   std::mutex mutex_;
 };
 
