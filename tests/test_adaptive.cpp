@@ -62,30 +62,34 @@ TEST(Adaptive, BlocksStopTogetherOnlyWhenEveryPixelIsBelowTheThreshold) {
   const Framebuffer fb = film(10, 6, 32, Vec3{1.0f}, Vec3{1.0f});  // noise 0 everywhere
   const NoiseTarget target{0.01f, 16, 1.0f};
   ActivePixels active;
-  active.update(fb, target);
+  active.update(fb, target, 32);
   EXPECT_EQ(active.active_pixels(), 0u);
   // One noisy pixel, (5, 4): its block, x 4-7, y 4-5, goes on; all of it, nothing else.
   Framebuffer noisy = film(10, 6, 32, Vec3{1.0f}, Vec3{1.0f});
   noisy.add(5, 4, Vec3{8.0f}, Vec3{0.0f}, 0);  // the mean rises, the half's does not
-  active.update(noisy, target);
+  active.update(noisy, target, 32);
   EXPECT_EQ(active.active_pixels(), 8u);
   for (int y = 0; y < 6; ++y)
     for (int x = 0; x < 10; ++x) EXPECT_EQ(active.active(x, y), x >= 4 && x < 8 && y >= 4) << x << "," << y;
   // Below the minimum samples nothing stops, however quiet.
-  active.update(film(10, 6, 8, Vec3{1.0f}, Vec3{1.0f}), target);
+  active.update(film(10, 6, 8, Vec3{1.0f}, Vec3{1.0f}), target, 8);
   EXPECT_EQ(active.active_pixels(), 60u);
   // The threshold is strict and the noise measured at the target's exposure.
   const Framebuffer edge = film(4, 4, 32, Vec3{0.3f}, Vec3{0.3f, 0.3f, 0.28f});
   const float e = pixel_noise(edge, 0, 0, 1.0f);
   ASSERT_GT(e, 0.0f);
-  active.update(edge, {e, 16, 1.0f});
+  active.update(edge, {e, 16, 1.0f}, 32);
   EXPECT_EQ(active.active_pixels(), 16u);
-  active.update(edge, {std::nextafter(e, 1.0f), 16, 1.0f});
+  active.update(edge, {std::nextafter(e, 1.0f), 16, 1.0f}, 32);
   EXPECT_EQ(active.active_pixels(), 0u);
   const float e2 = pixel_noise(edge, 0, 0, 2.0f);
   ASSERT_GT(e2, std::nextafter(e, 1.0f));  // at exposure 2 the same film shows more noise
-  active.update(edge, {std::nextafter(e, 1.0f), 16, 2.0f});
+  active.update(edge, {std::nextafter(e, 1.0f), 16, 2.0f}, 32);
   EXPECT_EQ(active.active_pixels(), 16u);
+  // A block with fewer samples than the pass boundary's stopped before: it stays stopped, noisy
+  // or not (its film has not changed since).
+  active.update(edge, {std::nextafter(e, 1.0f), 16, 2.0f}, 40);
+  EXPECT_EQ(active.active_pixels(), 0u);
 }
 
 struct AdaptiveRender {

@@ -17,7 +17,7 @@ float pixel_noise(const Framebuffer& fb, int x, int y, float exposure) {
   return difference / 3.0f;
 }
 
-void ActivePixels::update(const Framebuffer& fb, const NoiseTarget& target) {
+void ActivePixels::update(const Framebuffer& fb, const NoiseTarget& target, uint32_t taken) {
   const int w = fb.width(), h = fb.height();
   width_ = w;
   height_ = h;
@@ -27,6 +27,10 @@ void ActivePixels::update(const Framebuffer& fb, const NoiseTarget& target) {
   for (int by = 0; by < rows; ++by) {
     for (int bx = 0; bx < columns_; ++bx) {
       bool done = true;
+      if (fb.samples(bx * kBlock, by * kBlock) < taken) {
+        blocks_[size_t(by) * size_t(columns_) + size_t(bx)] = 0;
+        continue;
+      }
       for (int y = by * kBlock; done && y < std::min(h, (by + 1) * kBlock); ++y) {
         for (int x = bx * kBlock; done && x < std::min(w, (bx + 1) * kBlock); ++x) {
           done = fb.samples(x, y) >= target.min_samples && pixel_noise(fb, x, y, target.exposure) < target.threshold;

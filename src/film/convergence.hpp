@@ -58,8 +58,11 @@ class ActivePixels {
   // Every pixel active: the state before the first decision.
   ActivePixels() = default;
   // Decides from `fb` (kept with halves) which blocks go on: those with a pixel short of
-  // target.min_samples or at or above target.threshold.
-  void update(const Framebuffer& fb, const NoiseTarget& target);
+  // target.min_samples or at or above target.threshold. `taken`: the samples every pixel still
+  // going on has at this pass boundary; a block with fewer stopped at an earlier one and stays
+  // stopped without being measured again (its film has not changed since), so the cost of a
+  // decision falls with the pixels left.
+  void update(const Framebuffer& fb, const NoiseTarget& target, uint32_t taken);
   bool active(int x, int y) const {
     return blocks_.empty() || blocks_[size_t(y / kBlock) * size_t(columns_) + size_t(x / kBlock)] != 0;
   }

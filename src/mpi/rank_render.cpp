@@ -80,7 +80,7 @@ bool RankRender::render_round(const RenderContext& ctx, const std::vector<Sample
   if (session_.root()) {
     RenderContext c = ctx;
     if (masks) {
-      active_.update(*ctx.framebuffer, target);
+      active_.update(*ctx.framebuffer, target, round.front().first);
       c.active = &active_;
     }
     serve_round(c, round, samples);

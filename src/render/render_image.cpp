@@ -17,7 +17,7 @@ void choose_active_pixels(RenderContext& ctx, RenderControl& control) {
     control.active_pixels.store(ctx.framebuffer->pixel_count(), std::memory_order_relaxed);
     return;
   }
-  control.active.update(*ctx.framebuffer, target);
+  control.active.update(*ctx.framebuffer, target, ctx.samples.first);
   control.active_pixels.store(control.active.active_pixels(), std::memory_order_relaxed);
   ctx.active = &control.active;
 }
@@ -68,8 +68,11 @@ std::vector<SampleRange> sample_passes(const RenderSettings& settings) {
   std::vector<SampleRange> passes;
   const uint32_t total = uint32_t(std::max(settings.spp, 1));
   for (uint32_t done = 0; done < total;) {
-    const uint32_t count =
-        std::min({total - done, std::max(done, 1u), adaptive(settings) ? kAdaptivePassSamples : kMaxPassSamples});
+    // Adaptive: at least kAdaptivePassSamples, then an eighth of the samples so far (a pixel
+    // takes at most 1/8 more than it needed, and the decisions' cost stays small), up to 64.
+    const uint32_t most =
+        adaptive(settings) ? std::clamp(done / 8, kAdaptivePassSamples, kMaxPassSamples) : kMaxPassSamples;
+    const uint32_t count = std::min({total - done, std::max(done, 1u), most});
     passes.push_back({done, count});
     done += count;
   }

@@ -38,7 +38,8 @@ bool render_image(const Accelerator& accel, const RenderContext& ctx, const Sche
 // The passes of a render: settings.spp samples per pixel (ao and whitted: 1 by default) in
 // passes that double (1, 1, 2, 4, ... at most kMaxPassSamples), so a checkpoint or a stop finds
 // a complete image early and later passes keep the tile overhead small. With adaptive sampling
-// at most kAdaptivePassSamples, the samples between two decisions of which pixels go on.
+// passes are the samples between two decisions of which pixels go on: kAdaptivePassSamples, or
+// an eighth of those taken so far once that is more, up to kMaxPassSamples.
 inline constexpr uint32_t kMaxPassSamples = 64;
 inline constexpr uint32_t kAdaptivePassSamples = 8;
 std::vector<SampleRange> sample_passes(const RenderSettings& settings);
