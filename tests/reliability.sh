@@ -14,7 +14,8 @@ chmod 755 "$work"  # the unprivileged case must reach its file
 trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
-# Written before ok.obj: files newer than ok.obj are what a case left behind, and are removed.
+# The inputs are written first, then ok.obj is touched: files newer than it are what a case left
+# behind, and are removed after each case.
 # glTF and PLY: one triangle, its positions then uint16 indices, in a data: URI or a file.
 printf '\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\077\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200\077\0\0\0\0\0\0\001\0\002\0\0\0' > tri.bin
 gltf() {  # NODES INDEX-COUNT BUFFER-URI
@@ -120,6 +121,7 @@ mkfifo fifo.obj
 mkfifo silent.obj
 mkfifo nowriter.obj
 
+touch ok.obj  # after every input: an input in a later clock tick than ok.obj would be removed
 inputs=$(ls)
 as_user=()
 [[ $(id -u) -eq 0 ]] && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
