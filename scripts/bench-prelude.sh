@@ -12,3 +12,20 @@ T=${TRACER:-build/release/tracer}
 O=docs/bench
 mkdir -p "$O"
 field() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
+# path_scene_flags SCENE: the tracer flags of a path-traced benchmark scene (cornell-original,
+# cornell-water, sponza-sky). The Cornell boxes are lit by their own lamp (as their files define
+# them, and as the issue compares them with Cycles) and seen from their view's camera. The view's
+# point light is the AO study's: 8-9 cm under the lamp, whose diffuse underside it lights so
+# brightly that the lamp becomes a tiny, very bright reflector only BSDF sampling finds; fireflies
+# from it set a floor under the error of any sampler (RMSE ~0.025 at 1024 spp). Sponza is lit by a
+# white sky alone.
+path_scene_flags() {
+  local shared=${SHARED:-../shared}
+  case $1 in
+    cornell-original | cornell-water)
+      awk -F'\t' -v v="$1" -v s="$shared/scenes" '$1 == v { print s "/" $2, "--eye", $3, "--look", $4, "--up", $5, "--fov", $6 }' \
+        "$shared/scenes/views.tsv" ;;
+    sponza-sky) echo --view sponza --env 1,1,1 --no-scene-lights ;;
+    *) echo "unknown scene $1" >&2; return 2 ;;
+  esac
+}

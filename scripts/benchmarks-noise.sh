@@ -22,22 +22,9 @@ scenes=("$@")
 [[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell-original cornell-water sponza-sky)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-# The Cornell boxes are lit by their own lamp (as their files define them, and as the issue
-# compares them with Cycles) and seen from their view's camera. The view's point light is the AO
-# study's: 8-9 cm under the lamp, whose diffuse underside it lights so brightly that the lamp
-# becomes a tiny, very bright reflector only BSDF sampling finds; fireflies from it set a floor
-# under the error of any sampler (RMSE ~0.025 at 1024 spp).
-shared=${SHARED:-../shared}
-view_camera() {
-  awk -F'\t' -v v="$1" -v s="$shared/scenes" '$1 == v { print s "/" $2, "--eye", $3, "--look", $4, "--up", $5, "--fov", $6 }' \
-    "$shared/scenes/views.tsv"
-}
 for scene in "${scenes[@]}"; do
-  case $scene in
-    cornell-original | cornell-water) read -r -a flags <<<"$(view_camera "$scene")" ;;
-    sponza-sky) flags=(--view sponza --env 1,1,1 --no-scene-lights) ;;
-    *) echo "unknown scene $scene" >&2; exit 2 ;;
-  esac
+  line=$(path_scene_flags "$scene")
+  read -r -a flags <<<"$line"
   common=("${flags[@]}" --integrator path --width "$size" --height "$size" --threads 2 -q)
   fixed=(${FIXED_FLAGS---noise-threshold 0})
   $T render "${common[@]}" "${fixed[@]}" --spp 4096 --seed 99 -o "$work/ref.png"

@@ -2,6 +2,7 @@
 // never depends on thread count, scheduling order or tile size.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 namespace tracer {
@@ -23,6 +24,13 @@ struct SampleRng {
   constexpr SampleRng(uint32_t pixel, uint32_t sample, uint32_t seed = 0)
       : key(pcg_hash(pcg_hash(pixel ^ (seed * 0x9e3779b9u)) + sample)) {}
   constexpr float draw(uint32_t dimension) const { return to_unit_float(pcg_hash(key + dimension * 0x68e31da4u)); }
+  // PixelSampler's interface: dimension d of set `set` is draw(4 set + d), unstratified.
+  template <int N>
+  constexpr std::array<float, N> get(uint32_t set) const {
+    std::array<float, N> u{};
+    for (int d = 0; d < N; ++d) u[d] = draw(4 * set + uint32_t(d));
+    return u;
+  }
 };
 
 }  // namespace tracer

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "math/rng.hpp"
 #include "math/sobol.hpp"
 #include "parallel/tiles.hpp"
 #include "render/direct_light.hpp"
@@ -25,6 +26,11 @@ namespace tracer {
 // roulette). The 2D samples take a set's first two dimensions, the pair that forms (0,m,2)-nets;
 // a choice that has one outcome (one light, one lobe) draws no dimension, as each costs a hash.
 inline constexpr uint32_t kPixelSet = 0;
+#ifdef TRACER_INDEPENDENT_SAMPLES
+using PathSampler = SampleRng;  // the baseline scripts/benchmarks-sampler.sh measures against
+#else
+using PathSampler = PixelSampler;
+#endif
 constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
 constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
 constexpr uint32_t roulette_set(int depth) { return 3 + 3 * uint32_t(depth); }
@@ -45,7 +51,7 @@ inline std::array<float, 3> with_third(std::array<float, 2> u) { return {u[0], u
 
 // bsdf.sample with the dimensions of `set` its kind uses: a mirror none, glass one (its lobe), a
 // smooth surface two for the direction and a third for the lobe when it has two.
-inline bool sample_bsdf(const Bsdf& bsdf, Vec3 wo, const PixelSampler& sampler, uint32_t set, BsdfSample& out) {
+inline bool sample_bsdf(const Bsdf& bsdf, Vec3 wo, const PathSampler& sampler, uint32_t set, BsdfSample& out) {
   switch (bsdf.kind()) {
     case Bsdf::Kind::Mirror:
       return bsdf.sample(wo, 0.0f, 0.0f, 0.0f, out);
@@ -87,8 +93,8 @@ void add_sampled_light(const Accel& accel, const LightSampler& lights, const Sur
 }
 
 template <class Accel>
-Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PixelSampler& sampler,
-                   RayCounts& counts, FirstHit* first = nullptr) {
+Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PathSampler& sampler, RayCounts& counts,
+                   FirstHit* first = nullptr) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
   const LightSampler lights(ctx);
@@ -171,7 +177,7 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
       Vec3 sum{0.0f}, half{0.0f}, albedo{0.0f}, normal{0.0f};
       const bool aovs = ctx.albedo || ctx.normal;
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
-        const PixelSampler sampler(pixel, k, s.seed);
+        const PathSampler sampler(pixel, k, s.seed);
         const std::array<float, 2> pu = sampler.get<2>(kPixelSet);
         Ray ray;
         if (ctx.camera.thin_lens()) {
