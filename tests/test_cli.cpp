@@ -256,6 +256,19 @@ TEST_F(Cli, PathStatsCountSamplesAndCheckpoints) {
   EXPECT_EQ(read_image(dir_ + "/p.png").width, 8);
 }
 
+TEST_F(Cli, AdaptiveStatsAverageOverEveryFrame) {
+  // --min-spp is --spp: every pixel of both frames takes all 16 samples.
+  const auto r =
+      test::run_tracer("render -q --integrator path --spp 16 --min-spp 16 --frames 2 --width 8 --height 6 -o " + dir_ +
+                       "/f.png --stats --stats-json " + dir_ + "/f.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("16.0 taken on average"), std::string::npos) << r.output;
+  std::ifstream in(dir_ + "/f.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frames"], 2);
+  EXPECT_EQ(j["rays"]["primary"], 2 * 8 * 6 * 16);
+}
+
 TEST_F(Cli, SceneWithoutEmittersIsLitByAWhiteSkyWithANote) {
   const auto r = test::run_tracer("render " + dir_ + "/ok.obj --integrator path --spp 2 --width 8 --height 8 -o " +
                                   dir_ + "/e.png");

@@ -39,6 +39,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
                       {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
                       {"max_depth", settings.max_depth},
                       {"spp", settings.spp},
+                      {"frames", args.frames},
                       // Samples taken: one camera ray each (adaptive sampling skips pixels that have converged).
                       {"samples_per_s", render_ms > 0 ? double(rays.primary) / (render_ms * 1e-3) : 0.0},
                       {"noise_threshold", settings.integrator == Integrator::Path ? settings.noise_threshold : 0.0f},
@@ -82,7 +83,7 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
                                                    : "path, " + std::to_string(j["spp"].get<int>()) +
                                                          " samples per pixel, at most " + depth + " bounces";
   if (integrator == "path" && j["noise_threshold"].get<double>() > 0.0) {
-    const double pixels = double(j["width"].get<int>()) * j["height"].get<int>();
+    const double pixels = double(j["width"].get<int>()) * j["height"].get<int>() * j["frames"].get<int>();
     char adaptive[160];
     std::snprintf(adaptive, sizeof adaptive, " (adaptive: noise threshold %g, %.1f taken on average)",
                   j["noise_threshold"].get<double>(), double(j["rays"]["primary"].get<uint64_t>()) / pixels);
