@@ -171,6 +171,29 @@ TEST_F(ViewServerTest, ChangesRestartTheAccumulationExposureRetonesAoOnly) {
   EXPECT_EQ(s["exposure"], 2.0);
 }
 
+// Adaptive sampling's flags are path tracing's: launched with them, the view switches to ao without
+// them (its copied command too) and back to path tracing with them.
+TEST(ViewSession, AdaptiveFlagsFollowTheIntegrator) {
+  const Scene scene = make_cornell_box();
+  driver::RenderArgs args;
+  args.settings.width = 16;
+  args.settings.height = 12;
+  args.spp = 32;
+  args.noise_threshold = 0.02;
+  args.min_spp = 8;
+  const Accelerator accel = build_accelerator(scene, driver::accel_options_for(args));
+  view::ViewSession session(scene, accel, args, {"--noise-threshold", "0.02", "--min-spp", "8"}, view::kViewerFlags);
+  const std::string launched = session.state()["command"];
+  EXPECT_NE(launched.find("--noise-threshold 0.02 --min-spp 8"), std::string::npos) << launched;
+  EXPECT_EQ(launched.find("--noise-threshold", launched.find("--noise-threshold") + 1), std::string::npos) << launched;
+  const std::string ao = session.apply(json{{"integrator", "ao"}})["command"];
+  EXPECT_NE(ao.find("--integrator ao"), std::string::npos) << ao;
+  EXPECT_EQ(ao.find("--noise-threshold"), std::string::npos) << ao;
+  EXPECT_EQ(ao.find("--min-spp"), std::string::npos) << ao;
+  const std::string path = session.apply(json{{"integrator", "path"}})["command"];
+  EXPECT_NE(path.find("--noise-threshold 0.02 --min-spp 8"), std::string::npos) << path;
+}
+
 // A click focuses the lens on the surface under it: the focus distance is that surface's distance
 // along the view (brute force finds the same hit), and the copied command carries it.
 TEST_F(ViewServerTest, AClickSetsTheFocusDistanceToTheSurfaceThere) {

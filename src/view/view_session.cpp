@@ -120,6 +120,8 @@ std::string render_command(const driver::RenderArgs& a, const std::vector<std::s
   out += " --width " + std::to_string(a.settings.width) + " --height " + std::to_string(a.settings.height);
   out += " --integrator " + a.integrator + " --spp " + std::to_string(*a.spp);
   out += " --max-depth " + std::to_string(a.settings.max_depth) + " --exposure " + format_float(a.settings.exposure);
+  if (a.noise_threshold) out += " --noise-threshold " + shortest(*a.noise_threshold);
+  if (a.min_spp) out += " --min-spp " + std::to_string(*a.min_spp);
   return out;
 }
 
@@ -130,7 +132,9 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
       sched_(driver::sched_options_for(args)),
       user_flags_(std::move(user_flags)),
       viewer_flags_(std::move(viewer_flags)),
-      args_(args) {
+      args_(args),
+      noise_threshold_(args.noise_threshold),
+      min_spp_(args.min_spp) {
   // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
   // and settings are then derived from those explicit flags, as the command's will be.
   const CameraSpec camera = driver::camera_for(scene_, args_);
@@ -190,7 +194,10 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
       } else if (key == "integrator") {
         if (!value.is_string()) throw UsageError("integrator: expected a name, got " + value.dump());
         a.integrator = value.get<std::string>();
-        parse_name<Integrator>(kIntegratorNames, a.integrator, "integrator", "integrator");
+        const bool path =
+            parse_name<Integrator>(kIntegratorNames, a.integrator, "integrator", "integrator") == Integrator::Path;
+        a.noise_threshold = path ? noise_threshold_ : std::nullopt;
+        a.min_spp = path ? min_spp_ : std::nullopt;
       } else if (key == "spp") {
         a.spp = int_field(key, value, 1, 1 << 20);
       } else if (key == "max_depth") {

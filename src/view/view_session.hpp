@@ -33,9 +33,22 @@ inline constexpr int kMaxViewSide = 4096;
 
 // The flags of a `tracer render` command that the viewer's state sets, each taking one value. The
 // viewer's "copy command" drops them from the user's own flags and writes the current ones.
-inline constexpr const char* kStateFlags[] = {
-    "--eye", "-v",           "--look",      "--up",       "--fov", "--width",    "--height",
-    "--spp", "--integrator", "--max-depth", "--exposure", "-l",    "--aperture", "--focus-distance"};
+inline constexpr const char* kStateFlags[] = {"--eye",
+                                              "-v",
+                                              "--look",
+                                              "--up",
+                                              "--fov",
+                                              "--width",
+                                              "--height",
+                                              "--spp",
+                                              "--integrator",
+                                              "--max-depth",
+                                              "--exposure",
+                                              "-l",
+                                              "--aperture",
+                                              "--focus-distance",
+                                              "--noise-threshold",
+                                              "--min-spp"};
 
 // The command line of `tracer render` for `args`: `user_flags` (the view command's own arguments)
 // without the state's flags and the viewer's own (`viewer_flags`, each taking one value), then the
@@ -113,6 +126,10 @@ class ViewSession {
   mutable std::mutex mu_;
   std::condition_variable cv_;
   driver::RenderArgs args_;
+  // Adaptive sampling's flags as launched: path tracing's only, so another integrator renders
+  // without them and a switch back to path tracing takes them again.
+  std::optional<double> noise_threshold_;
+  std::optional<int> min_spp_;
   Job job_;
   uint64_t generation_ = 1;
   std::chrono::steady_clock::time_point last_change_{};
