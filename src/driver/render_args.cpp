@@ -104,7 +104,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                      (std::ostringstream() << kDefaultNoiseThreshold).str() + "; 0 gives every pixel --spp samples)");
   app.add_option("--min-spp", a.min_spp,
                  "path: adaptive sampling: samples every pixel takes before it may stop (2-1048576; default " +
-                     std::to_string(kDefaultMinSpp) + ")");
+                     std::to_string(RenderSettings{}.min_spp) + ")");
   app.add_option(
       "--env", a.env,
       "path, whitted: radiance r,g,b of a uniform environment, or the --env-map's scale (default black, 1,1,1 "

@@ -10,10 +10,10 @@ namespace tracer::driver {
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
 inline constexpr int kDefaultPathSpp = 64;
-// Adaptive sampling's noise threshold and minimum samples per pixel when their flags are not
-// given (docs/BENCHMARKS.md, adaptive sampling: how they were chosen).
+// Adaptive sampling's noise threshold when --noise-threshold is not given (docs/BENCHMARKS.md,
+// adaptive sampling: how it was chosen); the library's default is off. --min-spp's default is
+// RenderSettings'.
 inline constexpr double kDefaultNoiseThreshold = 0.01;
-inline constexpr int kDefaultMinSpp = 16;
 // settings_for() plus what depends on the scene: a path render of a scene with no emissive
 // surface and no --env is lit by a uniform white sky as well as any point lights (a point light
 // alone leaves everything it does not see black), and `note` says so.
