@@ -349,7 +349,9 @@ for c in "${cases[@]}"; do
   # How many samples a stopped path render finished depends on the machine's speed: shown as N.
   # tracer's own first line (mpirun's banners may come first); the bound tracer-mpi derives from
   # measured tile times is shown as N too.
-  first=$(printf '%s\n' "$stderr" | grep -m 1 '^tracer' || printf '%s\n' "$stderr" | head -n 1)
+  # From a here-string, not a pipe: grep -m 1 exits before a long stderr is written, and under
+  # pipefail the writer's SIGPIPE would run the fallback as well (two lines).
+  first=$(grep -m 1 '^tracer' <<<"$stderr" || head -n 1 <<<"$stderr")
   first=$(printf '%s\n' "$first" | sed -E 's/after [0-9]+ of/after N of/; s/within [0-9]+ s/within N s/; s/rank [0-9]+ of ([0-9]+): start-up/rank N of \1: start-up/')
   [[ -z $first ]] && first="(nothing)"
   left=$(comm -13 <(echo "$inputs") <(ls) | tr '\n' ' ')
