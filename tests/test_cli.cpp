@@ -391,17 +391,42 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   EXPECT_EQ(r.output.find("RMSE 0,"), std::string::npos) << r.output;
   r = test::run_tracer("compare " + d + "a.png " + d + "a.png");
   EXPECT_NE(r.output.find("PSNR inf dB"), std::string::npos) << r.output;
+  // Two EXR in display values: each channel tone-mapped at the exposure, not rounded to 8 bits.
+  {
+    const Framebuffer fa = read_exr(d + "a.exr"), fb = read_exr(d + "b.exr");
+    double sum = 0.0;
+    for (int y = 0; y < 8; ++y) {
+      for (int x = 0; x < 8; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          const double e = display_value(fa.radiance(x, y)[c], 0.5f) - display_value(fb.radiance(x, y)[c], 0.5f);
+          sum += e * e;
+        }
+      }
+    }
+    r = test::run_tracer("compare --exposure 0.5 " + d + "a.exr " + d + "b.exr");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const size_t at = r.output.find("8x8, display values 0-1 at exposure 0.5: RMSE ");
+    ASSERT_NE(at, std::string::npos) << r.output;
+    const double rmse = std::stod(r.output.substr(at + 46));
+    EXPECT_GT(rmse, 0.0);
+    EXPECT_NEAR(rmse, std::sqrt(sum / 192.0), 1e-5 * rmse) << r.output;
+  }
   for (const auto& [args, code, message] :
        {std::tuple{"a.exr c.exr", 2, "compare: sizes differ (8x8 and 8x6)"},
         std::tuple{"a.exr a.png", 2, "compare: both images must be EXR (linear) or both PNG/PPM (display)"},
+        std::tuple{"--exposure 1.5 a.png a.png", 2, "compare: --exposure tone-maps .exr images"},
+        std::tuple{"--exposure 0 a.exr a.exr", 2, "--exposure: Value 0 not in range"},
         std::tuple{"a.exr none.exr", 1, "none.exr: cannot open: no such file"},
         std::tuple{"a.exr nan.exr", 1, "nan.exr: 3 pixel values are not finite (NaN or infinity)"},
         std::tuple{"cut.exr cut.exr", 1, "cut.exr: "},
         std::tuple{"a.png claim.png", 2, "compare: sizes differ (8x8 and 8192x8192)"},
         std::tuple{"a.exr huge.exr", 1, "huge.exr: 4000000 x 1 pixels, outside the 1 to 16384 a side tracer reads"}}) {
-    std::string a = args;
-    a.insert(a.find(' ') + 1, d);
-    r = test::run_tracer("compare " + d + a);
+    // The last two words are files in the test's folder.
+    std::string a = " " + std::string(args);
+    const size_t second = a.rfind(' ');
+    a.insert(second + 1, d);
+    a.insert(a.rfind(' ', second - 1) + 1, d);
+    r = test::run_tracer("compare" + a);
     EXPECT_EQ(r.exit_code, code) << r.output;
     EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
     EXPECT_EQ(count_lines(r.output), 1) << r.output;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <sstream>
 
 #include "base/errors.hpp"
@@ -118,10 +119,11 @@ int cmd_info(const SceneArgs& args) {
   return 0;
 }
 
-int cmd_compare(const std::string& a, const std::string& b) {
-  const ImageDifference d = compare_images(a, b);
-  std::printf("%dx%d, %s: RMSE %.6g, largest difference %.6g", d.width, d.height,
-              d.linear ? "linear radiance" : "display values 0-1", d.rmse, d.max_abs);
+int cmd_compare(const std::string& a, const std::string& b, std::optional<float> exposure) {
+  const ImageDifference d = compare_images(a, b, exposure);
+  std::printf("%dx%d, %s", d.width, d.height, d.linear ? "linear radiance" : "display values 0-1");
+  if (exposure) std::printf(" at exposure %g", double(*exposure));
+  std::printf(": RMSE %.6g, largest difference %.6g", d.rmse, d.max_abs);
   if (!d.linear) std::printf(", PSNR %.2f dB", d.psnr_db);
   std::printf("\n");
   return 0;
@@ -163,6 +165,12 @@ int main(int argc, char** argv) {
       "compare", "RMSE between two images: linear radiance for two .exr, display values (and PSNR) for .png/.ppm");
   compare->add_option("a", compare_a, "an image (e.g. the reference)")->required();
   compare->add_option("b", compare_b, "an image of the same size and kind")->required();
+  std::optional<float> compare_exposure;
+  compare
+      ->add_option("--exposure", compare_exposure,
+                   "compare two .exr in display values, tone-mapped at this exposure as render's .png (not "
+                   "rounded to 8 bits)")
+      ->check(CLI::PositiveNumber);
 
   view::ViewArgs view_args;
   CLI::App* view_cmd = app.add_subcommand(
@@ -203,7 +211,7 @@ int main(int argc, char** argv) {
     }
     if (info->parsed()) return cmd_info(info_args);
     if (bench->parsed()) return run_bench(bench_args);
-    if (compare->parsed()) return cmd_compare(compare_a, compare_b);
+    if (compare->parsed()) return cmd_compare(compare_a, compare_b, compare_exposure);
   } catch (const UsageError& e) {
     std::cerr << "tracer: error: " << e.what() << "\n";
     return 2;

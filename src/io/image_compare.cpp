@@ -7,21 +7,24 @@
 
 #include "base/errors.hpp"
 #include "base/read_input.hpp"
+#include "film/tone_map.hpp"
 #include "io/image_io.hpp"
 
 namespace tracer {
 
-ImageDifference compare_images(const std::string& a, const std::string& b) {
+ImageDifference compare_images(const std::string& a, const std::string& b, std::optional<float> exposure) {
   const bool exr_a = image_format_for(a, "compare") == ImageFormat::Exr;
   const bool exr_b = image_format_for(b, "compare") == ImageFormat::Exr;
   if (exr_a != exr_b) throw UsageError("compare: both images must be EXR (linear) or both PNG/PPM (display)");
+  if (exposure && !exr_a) throw UsageError("compare: --exposure tone-maps .exr images; PNG/PPM are display values");
   ImageDifference d;
-  d.linear = exr_a;
+  d.linear = exr_a && !exposure;
+  const bool exr = exr_a;
   // Both read (within read_input's limits) and their sizes compared from the headers, before
   // either is decoded.
   const std::string bytes_a = read_input(a), bytes_b = read_input(b);
-  const ImageSize sa = d.linear ? exr_size(bytes_a, a) : image8_size(bytes_a, a);
-  const ImageSize sb = d.linear ? exr_size(bytes_b, b) : image8_size(bytes_b, b);
+  const ImageSize sa = exr ? exr_size(bytes_a, a) : image8_size(bytes_a, a);
+  const ImageSize sb = exr ? exr_size(bytes_b, b) : image8_size(bytes_b, b);
   if (!(sa == sb)) {
     throw UsageError("compare: sizes differ (" + std::to_string(sa.width) + "x" + std::to_string(sa.height) + " and " +
                      std::to_string(sb.width) + "x" + std::to_string(sb.height) + ")");
@@ -36,7 +39,7 @@ ImageDifference compare_images(const std::string& a, const std::string& b) {
     d.max_abs = std::max(d.max_abs, std::fabs(e));
     ++n;
   };
-  if (d.linear) {
+  if (exr) {
     const Framebuffer fa = decode_exr(bytes_a, a), fb = decode_exr(bytes_b, b);
     // A NaN or infinity has no difference to measure: refused, naming the file and the count.
     for (const auto& [image, path] : {std::pair{&fa, &a}, {&fb, &b}}) {
@@ -55,7 +58,13 @@ ImageDifference compare_images(const std::string& a, const std::string& b) {
     for (int y = 0; y < fa.height(); ++y) {
       for (int x = 0; x < fa.width(); ++x) {
         const Vec3 p = fa.radiance(x, y), q = fb.radiance(x, y);
-        for (int c = 0; c < 3; ++c) add(p[c], q[c]);
+        for (int c = 0; c < 3; ++c) {
+          if (exposure) {
+            add(display_value(p[c], *exposure), display_value(q[c], *exposure));
+          } else {
+            add(p[c], q[c]);
+          }
+        }
       }
     }
   } else {
