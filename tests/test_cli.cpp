@@ -373,6 +373,7 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   auto r = test::run_tracer("compare " + d + "a.exr " + d + "a.exr");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("8x8, linear radiance: RMSE 0,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" (+0.00 %)"), std::string::npos) << r.output;  // the two means, equal
   // An image with one NaN texel, a 2048 x 1024 one cut after 400 bytes, a PNG header claiming
   // 8192 x 8192 with no pixels behind it, and an EXR header claiming 4000000 x 1 (sizes are read
   // from the headers, before any pixel is decoded).
@@ -394,12 +395,13 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
   // Two EXR in display values: each channel tone-mapped at the exposure, not rounded to 8 bits.
   {
     const Framebuffer fa = read_exr(d + "a.exr"), fb = read_exr(d + "b.exr");
-    double sum = 0.0;
+    double sum = 0.0, sum_b = 0.0;
     for (int y = 0; y < 8; ++y) {
       for (int x = 0; x < 8; ++x) {
         for (int c = 0; c < 3; ++c) {
           const double e = display_value(fa.radiance(x, y)[c], 0.5f) - display_value(fb.radiance(x, y)[c], 0.5f);
           sum += e * e;
+          sum_b += display_value(fb.radiance(x, y)[c], 0.5f);
         }
       }
     }
@@ -410,6 +412,9 @@ TEST_F(Cli, CompareGivesRmseAndRejectsMismatchedImages) {
     const double rmse = std::stod(r.output.substr(at + 46));
     EXPECT_GT(rmse, 0.0);
     EXPECT_NEAR(rmse, std::sqrt(sum / 192.0), 1e-5 * rmse) << r.output;
+    const size_t and_at = r.output.find(" and ", r.output.find("means "));
+    ASSERT_NE(and_at, std::string::npos) << r.output;
+    EXPECT_NEAR(std::stod(r.output.substr(and_at + 5)), sum_b / 192.0, 1e-5) << r.output;
   }
   for (const auto& [args, code, message] :
        {std::tuple{"a.exr c.exr", 2, "compare: sizes differ (8x8 and 8x6)"},

@@ -125,6 +125,8 @@ int cmd_compare(const std::string& a, const std::string& b, std::optional<float>
   if (exposure) std::printf(" at exposure %g", double(*exposure));
   std::printf(": RMSE %.6g, largest difference %.6g", d.rmse, d.max_abs);
   if (!d.linear) std::printf(", PSNR %.2f dB", d.psnr_db);
+  std::printf(", means %.6g and %.6g", d.mean_a, d.mean_b);
+  if (d.mean_a > 0.0) std::printf(" (%+.2f %%)", 100.0 * (d.mean_b / d.mean_a - 1.0));
   std::printf("\n");
   return 0;
 }

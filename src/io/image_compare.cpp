@@ -31,11 +31,13 @@ ImageDifference compare_images(const std::string& a, const std::string& b, std::
   }
   d.width = sa.width;
   d.height = sa.height;
-  double sum = 0.0;
+  double sum = 0.0, sum_a = 0.0, sum_b = 0.0;
   size_t n = 0;
   const auto add = [&](double x, double y) {
     const double e = x - y;
     sum += e * e;
+    sum_a += x;
+    sum_b += y;
     d.max_abs = std::max(d.max_abs, std::fabs(e));
     ++n;
   };
@@ -72,6 +74,8 @@ ImageDifference compare_images(const std::string& a, const std::string& b, std::
     for (size_t i = 0; i < ia.rgb.size(); ++i) add(ia.rgb[i] / 255.0, ib.rgb[i] / 255.0);
   }
   d.rmse = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
+  d.mean_a = n > 0 ? sum_a / double(n) : 0.0;
+  d.mean_b = n > 0 ? sum_b / double(n) : 0.0;
   if (!d.linear) d.psnr_db = d.rmse > 0.0 ? 20.0 * std::log10(1.0 / d.rmse) : std::numeric_limits<double>::infinity();
   return d;
 }

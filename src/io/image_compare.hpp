@@ -15,8 +15,9 @@ struct ImageDifference {
   int width = 0, height = 0;
   bool linear = false;  // both EXR, no exposure: the RMSE is in linear radiance
   double rmse = 0.0;
-  double max_abs = 0.0;  // the largest difference of any channel
-  double psnr_db = 0.0;  // display images only (infinite when identical)
+  double max_abs = 0.0;               // the largest difference of any channel
+  double mean_a = 0.0, mean_b = 0.0;  // each image's mean over pixels and channels, in the same values
+  double psnr_db = 0.0;               // display images only (infinite when identical)
 };
 
 // `exposure`: compare two EXR files in display values at this exposure. Throws InputError naming
