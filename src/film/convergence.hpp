@@ -37,10 +37,12 @@
 
 namespace tracer {
 
+// Made from the render's settings by noise_target() (render/render_image.hpp), which holds the
+// defaults; the film only applies it.
 struct NoiseTarget {
-  float threshold = 0.0f;     // e at which a block stops; 0: adaptive sampling off
-  uint32_t min_samples = 16;  // no pixel stops before it has this many
-  float exposure = 1.0f;      // e is measured on radiance times this
+  float threshold = 0.0f;    // e at which a block stops; 0: adaptive sampling off
+  uint32_t min_samples = 2;  // no pixel stops before it has this many (e needs two)
+  float exposure = 1.0f;     // e is measured on radiance times this
 };
 
 // Whether sample `k` of a pixel belongs to the half A is the mean of: one of each pair 2m, 2m+1,
