@@ -29,3 +29,22 @@ path_scene_flags() {
     *) echo "unknown scene $1" >&2; return 2 ;;
   esac
 }
+# seconds_to_rmse TARGET...: from rows "label seconds - rmse" on stdin (renders in order of falling
+# error), the seconds to reach each target RMSE, interpolated in log-log between the two renders
+# that bracket it; "<s" when the first render is already below, "-" when none reaches it.
+seconds_to_rmse() {
+  awk -v targets="$*" '{ s[NR] = $2; e[NR] = $4; n = NR }
+    END {
+      m = split(targets, target, " ")
+      for (t = 1; t <= m; ++t) {
+        x = target[t]; out = "-"
+        if (e[1] <= x) out = sprintf("<%.2f", s[1])
+        else for (i = 1; i < n; ++i) if (e[i] > x && e[i + 1] <= x) {
+          f = log(e[i] / x) / log(e[i] / e[i + 1])
+          out = sprintf("%.2f", exp(log(s[i]) + f * (log(s[i + 1]) - log(s[i]))))
+        }
+        printf "%s%s", (t > 1 ? " " : ""), out
+      }
+      print ""
+    }'
+}

@@ -79,24 +79,6 @@ render() {
 }
 rmse() { $T compare --exposure "$exposure" "$1" "$2" | sed -E 's/.*RMSE ([^,]*),.*/\1/'; }
 
-# Seconds to RMSE 0.02, 0.01, 0.005 from rows "label wall render rmse" in order of falling error.
-to_rmse() {
-  awk '{ s[NR] = $2; e[NR] = $4; n = NR }
-    END {
-      split("0.02 0.01 0.005", targets, " ")
-      for (t = 1; t <= 3; ++t) {
-        x = targets[t]; out = "-"
-        if (e[1] <= x) out = sprintf("<%.1f", s[1])
-        else for (i = 1; i < n; ++i) if (e[i] > x && e[i + 1] <= x) {
-          f = log(e[i] / x) / log(e[i] / e[i + 1])
-          out = sprintf("%.1f", exp(log(s[i]) + f * (log(s[i + 1]) - log(s[i]))))
-        }
-        printf "%s%s", (t > 1 ? " " : ""), out
-      }
-      print ""
-    }'
-}
-
 for name in "${scenes[@]}"; do
   read -r obj eye look up fov sky <<<"$(scene_of "$name")"
   declare -A ref_time fixed adaptive thresholds
@@ -164,10 +146,10 @@ for name in "${scenes[@]}"; do
         '{ printf "%s reference'"'"'s own RMSE: about %.5f (from %d spp)\n", who, $4 / sqrt(1 + ref / $1), $1 }'
     done
     echo
-    read -r -a tf <<<"$(to_rmse <<<"${fixed[tracer]}")"
-    read -r -a cf <<<"$(to_rmse <<<"${fixed[cycles]}")"
-    read -r -a ta <<<"$(to_rmse <<<"${adaptive[tracer]}")"
-    read -r -a ca <<<"$(to_rmse <<<"${adaptive[cycles]}")"
+    read -r -a tf <<<"$(seconds_to_rmse 0.02 0.01 0.005 <<<"${fixed[tracer]}")"
+    read -r -a cf <<<"$(seconds_to_rmse 0.02 0.01 0.005 <<<"${fixed[cycles]}")"
+    read -r -a ta <<<"$(seconds_to_rmse 0.02 0.01 0.005 <<<"${adaptive[tracer]}")"
+    read -r -a ca <<<"$(seconds_to_rmse 0.02 0.01 0.005 <<<"${adaptive[cycles]}")"
     ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a ~ /^[0-9.]+$/ && b ~ /^[0-9.]+$/) printf "%.2f", a / b; else print "-" }'; }
     echo "| RMSE | tracer, adaptive (default) | Cycles, adaptive (default) | ratio | tracer, fixed | Cycles, fixed | ratio |"
     echo "|---:|---:|---:|---:|---:|---:|---:|"

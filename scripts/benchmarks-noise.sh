@@ -63,24 +63,8 @@ for scene in "${scenes[@]}"; do
       done
       echo
     fi
-    # Seconds to each RMSE, interpolated in log-log between the runs that bracket it (runs in
-    # order of falling error).
-    to_rmse() {
-      awk '{ s[NR] = $2 / 1000; e[NR] = $4; n = NR }
-        END {
-          split("0.02 0.01 0.005 0.0025", targets, " ")
-          for (t = 1; t <= 4; ++t) {
-            x = targets[t]; out = "-"
-            if (e[1] <= x) out = sprintf("<%.2f", s[1])
-            else for (i = 1; i < n; ++i) if (e[i] > x && e[i + 1] <= x) {
-              f = log(e[i] / x) / log(e[i] / e[i + 1])
-              out = sprintf("%.2f", exp(log(s[i]) + f * (log(s[i + 1]) - log(s[i]))))
-            }
-            printf "%s%s", (t > 1 ? " " : ""), out
-          }
-          print ""
-        }'
-    }
+    # Seconds to each RMSE (the rows' times are milliseconds).
+    to_rmse() { awk '{ $2 = $2 / 1000; print }' | seconds_to_rmse 0.02 0.01 0.005 0.0025; }
     read -r -a by_spp <<<"$(printf '%s\n' "${rows[@]}" | to_rmse)"
     by_threshold=(- - - -)
     [[ -n ${ADAPTIVE:-} ]] && read -r -a by_threshold <<<"$(printf '%s\n' "${adaptive[@]}" | to_rmse)"
