@@ -22,7 +22,7 @@
 # Cycles (as pbrt-v4) over the pixel's footprint, and with them the converged images differ by
 # 17 % in mean radiance at 512x512 (docs/BENCHMARKS.md section 18).
 # Writes docs/bench/cycles-SCENE.md (cycles-SCENE-SIZE.md for another SIZE). About 20 minutes for
-# the Cornell Original at 512x512 on 2 cores, 9 each for Water and Sponza at 256x256.
+# each Cornell box at 512x512 on 2 cores, 9 for Sponza at 256x256.
 if [[ ${1:-} == --install ]]; then
   shift
   command -v blender >/dev/null || { apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q blender; }
