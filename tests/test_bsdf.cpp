@@ -196,31 +196,48 @@ TEST(Bsdf, DielectricReflectsTheFresnelFractionAndRefractsBySnell) {
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   const Frame frame(Vec3{0.0f, 0.0f, 1.0f});
-  for (const float eta : {1.5f, 1.0f / 1.5f}) {
-    const Bsdf glass = Bsdf::dielectric(frame, eta, Vec3{1.0f});
-    for (const float theta : {0.0f, 30.0f, 40.0f, 60.0f}) {
-      const Vec3 wo = direction(theta);
-      const float f = fresnel_dielectric(wo.z, 1.0f, eta);
-      const int n = 100000;
-      int reflected = 0;
-      for (int i = 0; i < n; ++i) {
-        BsdfSample s;
-        ASSERT_TRUE(glass.sample(wo, u(gen), u(gen), u(gen), s));
-        ASSERT_TRUE(s.delta);
-        if (!s.transmitted) {
-          ++reflected;
-          EXPECT_NEAR(s.wi.z, wo.z, 1e-6f);
-          EXPECT_NEAR(s.wi.x, -wo.x, 1e-6f);
-          EXPECT_FLOAT_EQ(s.weight.x, 1.0f);
-        } else {
-          // Snell: sin_t = sin_i / eta; the radiance scales by 1 / eta^2.
-          EXPECT_NEAR(std::sqrt(s.wi.x * s.wi.x + s.wi.y * s.wi.y), std::sin(theta * kPi / 180.0f) / eta, 1e-5f);
-          EXPECT_LT(s.wi.z, 0.0f);
-          EXPECT_NEAR(s.weight.x, 1.0f / (eta * eta), 1e-6f);
+  // Clear glass, and a dim coloured filter (as water's Tf 0.1), which makes reflection the likelier
+  // choice: it is chosen in proportion to f against (1 - f) * luminance(Tf), each weighted so that
+  // the estimate is f for the reflection and Tf (1 - f) / eta^2 for the refraction.
+  for (const Vec3 tf : {Vec3{1.0f}, Vec3{0.1f, 0.2f, 0.05f}}) {
+    for (const float eta : {1.5f, 1.0f / 1.5f}) {
+      const Bsdf glass = Bsdf::dielectric(frame, eta, tf);
+      for (const float theta : {0.0f, 30.0f, 40.0f, 60.0f}) {
+        const Vec3 wo = direction(theta);
+        const float f = fresnel_dielectric(wo.z, 1.0f, eta);
+        const double p_reflect = f / (f + (1.0 - f) * luminance(tf));
+        const int n = 100000;
+        int reflected = 0;
+        Vec3 reflected_sum{0.0f}, transmitted_sum{0.0f};
+        for (int i = 0; i < n; ++i) {
+          BsdfSample s;
+          ASSERT_TRUE(glass.sample(wo, u(gen), u(gen), u(gen), s));
+          ASSERT_TRUE(s.delta);
+          if (!s.transmitted) {
+            ++reflected;
+            EXPECT_NEAR(s.wi.z, wo.z, 1e-6f);
+            EXPECT_NEAR(s.wi.x, -wo.x, 1e-6f);
+            EXPECT_NEAR(s.weight.x, f / p_reflect, 1e-5f);
+            reflected_sum += s.weight;
+          } else {
+            // Snell: sin_t = sin_i / eta; the radiance scales by 1 / eta^2.
+            EXPECT_NEAR(std::sqrt(s.wi.x * s.wi.x + s.wi.y * s.wi.y), std::sin(theta * kPi / 180.0f) / eta, 1e-5f);
+            EXPECT_LT(s.wi.z, 0.0f);
+            EXPECT_NEAR(s.weight.y, tf.y * (1.0f - f) / ((1.0f - p_reflect) * eta * eta), 1e-5f);
+            transmitted_sum += s.weight;
+          }
+        }
+        const double frac = double(reflected) / n;
+        EXPECT_NEAR(frac, p_reflect, 4.0 * std::sqrt(p_reflect * (1.0 - p_reflect) / n) + 1e-6) << eta << " " << theta;
+        // The estimates' means are f and Tf (1 - f) / eta^2, within 4 sigma of the binomial count.
+        const double sigma = std::sqrt(p_reflect * (1.0 - p_reflect) / n);
+        EXPECT_NEAR(reflected_sum.x / n, f, 4.0 * sigma * f / p_reflect + 1e-6) << eta << " " << theta;
+        for (int c = 0; c < 3 && p_reflect < 1.0; ++c) {  // beyond the critical angle nothing passes
+          const double expect = tf[c] * (1.0 - f) / (eta * eta);
+          EXPECT_NEAR(transmitted_sum[c] / n, expect, 4.0 * sigma * expect / (1.0 - p_reflect) + 1e-6)
+              << eta << " " << theta << " " << c;
         }
       }
-      const double frac = double(reflected) / n;
-      EXPECT_NEAR(frac, f, 4.0 * std::sqrt(f * (1.0 - f) / n) + 1e-6) << eta << " " << theta;
     }
   }
   // Normal incidence from air onto n = 1.5: ((n - 1) / (n + 1))^2 = 0.04.

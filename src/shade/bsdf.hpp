@@ -93,17 +93,25 @@ class Bsdf {
         out = {.wi = frame_.to_world({-wo.x, -wo.y, wo.z}), .weight = ks_, .pdf = 1.0f, .delta = true};
         return true;
       case Kind::Dielectric: {
+        // Reflection or refraction, chosen in proportion to what each carries: the Fresnel
+        // reflectance f, and 1 - f through the filter Tf. A dim filter (water's Tf 0.1) makes
+        // the reflections, a lamp's highlight among them, the larger part of what is seen.
         const float f = fresnel_dielectric(wo.z, 1.0f, eta_);
-        if (u_lobe < f) {
-          out = {.wi = frame_.to_world({-wo.x, -wo.y, wo.z}), .weight = Vec3{1.0f}, .pdf = f, .delta = true};
+        const float t = (1.0f - f) * luminance(kd_);
+        const float p_reflect = f + t > 0.0f ? f / (f + t) : 1.0f;
+        if (u_lobe < p_reflect) {
+          out = {.wi = frame_.to_world({-wo.x, -wo.y, wo.z}),
+                 .weight = Vec3{f / p_reflect},
+                 .pdf = p_reflect,
+                 .delta = true};
           return true;
         }
         Vec3 wt;
         if (!refract(-wo, Vec3{0.0f, 0.0f, 1.0f}, 1.0f / eta_, wt)) return false;  // f was 1: not reached
         // Radiance scales by 1/eta^2 crossing into the denser side (it is L/n^2 that is conserved).
         out = {.wi = frame_.to_world(wt),
-               .weight = kd_ / (eta_ * eta_),
-               .pdf = 1.0f - f,
+               .weight = kd_ * ((1.0f - f) / ((1.0f - p_reflect) * eta_ * eta_)),
+               .pdf = 1.0f - p_reflect,
                .delta = true,
                .transmitted = true};
         return true;
