@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <random>
@@ -12,6 +13,7 @@
 #include "render/render_tile.hpp"
 
 #include "accel/accelerator.hpp"
+#include "accel/builders/spatial_split.hpp"
 #include "importers/obj_loader.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
@@ -26,9 +28,9 @@ struct TargetGuard {
   ~TargetGuard() { WideBvh::force_simd_target("auto"); }
 };
 
-size_t disagreements(const Scene& scene, const std::vector<Ray>& rays) {
+size_t disagreements(const Scene& scene, const std::vector<Ray>& rays, const BvhBuildOptions& wide_options = {}) {
   const Bvh bin(scene, BvhBuildOptions{});
-  const WideBvh wide(scene, BvhBuildOptions{});
+  const WideBvh wide(scene, wide_options);
   EXPECT_EQ(wide.validate(), "");
   size_t bad = 0;
   for (const Ray& r : rays) {
@@ -77,6 +79,15 @@ void for_each_target_and_scene(const std::function<void(const Scene&)>& check) {
 TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
   for_each_target_and_scene([](const Scene& scene) {
     EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 77)), 0u);
+  });
+}
+
+// Spatial splits cut references, never triangles: the same hits as the binary tree.
+TEST(WideBvh, SpatialSplitsAgreeWithBinaryBvhOnEveryTarget) {
+  BvhBuildOptions high;
+  high.split_budget = kHighSplitBudget;
+  for_each_target_and_scene([&](const Scene& scene) {
+    EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 78), high), 0u);
   });
 }
 
@@ -275,11 +286,16 @@ TEST(WideBvh, DirectBuildGivesTheCollapsedBinaryTree) {
   }
 }
 
-// Every executor and thread count builds the same tree, byte for byte.
-TEST(WideBvh, SameTreeUnderEveryExecutorAndThreadCount) {
+// Every executor and thread count builds the same tree, byte for byte, with and without spatial
+// splits.
+class WideBvhBudget : public testing::TestWithParam<float> {};
+INSTANTIATE_TEST_SUITE_P(Budgets, WideBvhBudget, testing::Values(0.0f, kHighSplitBudget));
+
+TEST_P(WideBvhBudget, SameTreeUnderEveryExecutorAndThreadCount) {
   const Scene scene = many_spheres();
   ASSERT_GT(scene.size(), 100'000u);
   BvhBuildOptions options;
+  options.split_budget = GetParam();
   options.mode = BuildMode::Seq;
   const WideBvh ref(scene, options);
   EXPECT_EQ(ref.validate(), "");
@@ -295,6 +311,92 @@ TEST(WideBvh, SameTreeUnderEveryExecutorAndThreadCount) {
       EXPECT_EQ(std::memcmp(w.packs().data(), ref.packs().data(), ref.packs().size() * sizeof(TrianglePack)), 0);
     }
   }
+}
+
+// Small triangles scattered in a room, crossed by long diagonal slivers (a vault's ribs, a
+// stair's rails): the slivers' boxes swallow the room, so the binned SAH's children overlap;
+// spatial splits must cut them within their budget, keep every hit, and visit fewer nodes and
+// packs per ray.
+TEST(WideBvh, SpatialSplitsCutLongTrianglesWithinTheBudget) {
+  std::vector<Triangle> tris;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 8000; ++i) {
+    const Vec3 a{u(rng) * 10, u(rng) * 10, u(rng) * 10};
+    tris.push_back({a, a + Vec3{u(rng), u(rng), u(rng)} * 0.3f, a + Vec3{u(rng), u(rng), u(rng)} * 0.3f});
+  }
+  for (int i = 0; i < 100; ++i) {
+    const Vec3 a{u(rng) * 10, u(rng) * 10, -10.0f}, b{u(rng) * 10, u(rng) * 10, 10.0f};
+    tris.push_back({a, b, b + Vec3{u(rng), u(rng), 0.0f} * 0.2f});
+  }
+  const Scene scene = test::scene_of(tris);
+  BvhBuildOptions high;
+  high.split_budget = kHighSplitBudget;
+  const WideBvh medium_tree(scene, BvhBuildOptions{}), high_tree(scene, high);
+  EXPECT_FALSE(medium_tree.spatial_splits());
+  ASSERT_TRUE(high_tree.spatial_splits());
+  EXPECT_EQ(high_tree.validate(), "");
+  std::vector<uint32_t> medium_refs, high_refs;
+  collect(medium_tree, 0, medium_refs);
+  collect(high_tree, 0, high_refs);
+  EXPECT_EQ(medium_refs.size(), tris.size());
+  EXPECT_GT(high_refs.size(), tris.size() * 21 / 20) << "spatial splits should add references";
+  EXPECT_LE(high_refs.size(), tris.size() * 6 / 5) << "at most 20 % more references";
+  const std::vector<Ray> rays = test::random_rays(scene, 20'000, 9);
+  EXPECT_EQ(disagreements(scene, rays, high), 0u);
+  TraversalCounts m, h;
+  for (const Ray& r : rays) {
+    Hit a, b;
+    medium_tree.intersect(r, a, m);
+    high_tree.intersect(r, b, h);
+  }
+  // Measured: 156k -> 127k nodes, 134k -> 70k packs, 8100 triangles -> 9526 references.
+  EXPECT_LT(double(h.nodes + h.packs), 0.8 * double(m.nodes + m.packs))
+      << "nodes " << m.nodes << " -> " << h.nodes << ", packs " << m.packs << " -> " << h.packs;
+}
+
+// A cut triangle's parts: each side's box holds every point of the triangle on that side (within
+// the reference's box), lies in the triangle's box, and is empty where the triangle does not reach.
+TEST(SpatialSplit, ClippedBoxesHoldTheirPartOfTheTriangle) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), w(0.0f, 1.0f);
+  int cut = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Triangle t{{u(rng) * 100, u(rng), u(rng)}, {u(rng), u(rng) * 100, u(rng)}, {u(rng), u(rng), u(rng) * 100}};
+    const int axis = k % 3;
+    const Aabb tb = t.bounds();
+    const float pos = tb.lo[axis] + (tb.hi[axis] - tb.lo[axis]) * (1.2f * w(rng) - 0.1f);
+    Aabb left, right;
+    clip_triangle(t, tb, axis, pos, left, right);
+    EXPECT_EQ(left.empty(), tb.lo[axis] > pos);
+    EXPECT_EQ(right.empty(), tb.hi[axis] < pos);
+    if (!left.empty() && !right.empty()) ++cut;
+    for (const Aabb* b : {&left, &right}) {
+      if (!b->empty()) {
+        EXPECT_TRUE(tb.contains(*b));
+      }
+    }
+    for (int s = 0; s < 200; ++s) {
+      float b1 = w(rng), b2 = w(rng);
+      if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+      const Vec3 p = t.v0 * (1.0f - b1 - b2) + t.v1 * b1 + t.v2 * b2;
+      const Aabb& side = p[axis] <= pos ? left : right;
+      Aabb point;
+      point.extend(p);
+      // p itself is rounded; the box must hold it to within that rounding.
+      Aabb grown = side;
+      for (int a = 0; a < 3; ++a) {
+        const float slack = 1e-5f * std::max(std::fabs(p[a]), 1.0f);
+        grown.lo[a] -= slack;
+        grown.hi[a] += slack;
+      }
+      if (!grown.contains(point)) {
+        ADD_FAILURE() << "point outside its side's box, axis " << axis << " plane " << pos;
+        return;
+      }
+    }
+  }
+  EXPECT_GT(cut, 1000);
 }
 
 TEST(WideBvh, WatertightClosedSphere) {

@@ -45,13 +45,17 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);
       acc.name = options.bvh.split == BvhSplit::Sah ? "bvh-sah" : "bvh-median";
       break;
-    case AccelKind::Bvh8:
-      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, options.bvh);
-      acc.name = "bvh8-" + WideBvh::simd_target();
+    case AccelKind::Bvh8: {
+      BvhBuildOptions bvh = options.bvh;
+      const bool high = options.quality == BuildQuality::High;
+      bvh.split_budget = high ? kHighSplitBudget : 0.0f;
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, bvh);
+      acc.name = "bvh8-" + WideBvh::simd_target() + (high ? "-high" : "");
       break;
+    }
     case AccelKind::Embree:
     case AccelKind::EmbreeHigh: {
-      const bool high = options.kind == AccelKind::EmbreeHigh;
+      const bool high = options.kind == AccelKind::EmbreeHigh || options.quality == BuildQuality::High;
 #ifdef TRACER_HAVE_EMBREE
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<EmbreeAccel>, scene, options.bvh.cancel, nullptr,
                                                 high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);

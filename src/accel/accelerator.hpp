@@ -35,8 +35,19 @@ inline constexpr EnumName<AccelKind> kAccelKindNames[] = {{AccelKind::BruteSimd,
                                                           {AccelKind::EmbreeHigh, "embree-high"}};
 inline bool is_embree(AccelKind kind) { return kind == AccelKind::Embree || kind == AccelKind::EmbreeHigh; }
 
+// How much a build spends for faster traversal, as Embree's RTC_BUILD_QUALITY_MEDIUM and _HIGH:
+// the binned SAH, or the binned SAH with spatial splits adding at most kHighSplitBudget of the
+// triangles as extra references (Embree's HIGH allows the same 20 %).
+enum class BuildQuality { Medium, High };
+inline constexpr EnumName<BuildQuality> kBuildQualityNames[] = {{BuildQuality::Medium, "medium"},
+                                                                {BuildQuality::High, "high"}};
+inline constexpr float kHighSplitBudget = 0.2f;
+// Whether `kind` builds at a quality level: the 8-wide BVH and Embree.
+inline bool has_build_quality(AccelKind kind) { return kind == AccelKind::Bvh8 || is_embree(kind); }
+
 struct AccelOptions {
-  AccelKind kind = AccelKind::Bvh8;  // the fastest (docs/BENCHMARKS.md section 1)
+  AccelKind kind = AccelKind::Bvh8;             // the fastest (docs/BENCHMARKS.md section 1)
+  BuildQuality quality = BuildQuality::Medium;  // Bvh8 and Embree; EmbreeHigh is always High
   BvhBuildOptions bvh;
 };
 

@@ -191,7 +191,10 @@ Strategy strategy_for(BuildMode mode) {
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options)
     : Bvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
 
-Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec) : scene_(&scene), options_(options) {
+Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
+    : scene_(&scene), options_(options_in) {
+  options_.split_budget = 0.0f;  // one leaf per triangle (leaf_of)
+  const BvhBuildOptions& options = options_;
   exec.run([&] {
     BvhBuilder builder(scene, options, exec);
     builder.build();

@@ -1,5 +1,6 @@
 // Splitting a set of triangles in two, as every BVH builder here does it: the binned SAH (or the
-// study's object median), over an array of primitive boxes partitioned in place of the triangles.
+// study's object median), over an array of primitive boxes partitioned in place of the triangles,
+// and, where the build has a reference budget, spatial splits (spatial_split.hpp).
 // The binary BVH's builder and the 8-wide BVH's direct builder both split with this one class, so
 // a range gets the same two halves in either tree.
 //
@@ -42,6 +43,12 @@ struct alignas(32) PrimRef {
     return _mm_cvtss_f32(_mm_shuffle_ps(c, c, _MM_SHUFFLE(Axis, Axis, Axis, Axis)));
   }
   float center(int axis) const { return axis == 0 ? center<0>() : axis == 1 ? center<1>() : center<2>(); }
+  Aabb box() const {
+    alignas(16) float a[4], b[4];
+    _mm_store_ps(a, lo);
+    _mm_store_ps(b, hi);
+    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
+  }
 };
 static_assert(sizeof(PrimRef) == 32);
 
@@ -51,6 +58,7 @@ struct PrimRange {
   Aabb box;   // of the primitives' boxes
   Aabb cbox;  // of their centroids
   uint32_t begin = 0, end = 0;
+  uint32_t room = 0;          // free slots after `end` this range may fill with spatial splits
   uint32_t depth = 0;         // splits from the root: past kMedianFallbackDepth, halve by count
   bool bounds_known = false;  // box and cbox valid
   uint32_t size() const { return end - begin; }
@@ -66,30 +74,39 @@ class PrimSplitter {
   PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 
   uint32_t count() const { return count_; }
-  PrimRange root() const { return PrimRange{{}, {}, 0, count_, 0, false}; }
-  // The primitives; a range's are refs()[begin, end), in no particular order.
+  // Slots for references: count() and the spatial splits' budget.
+  uint32_t capacity() const { return capacity_; }
+  PrimRange root() const { return PrimRange{{}, {}, 0, count_, capacity_ - count_, 0, false}; }
+  // The primitives; a range's are refs()[begin, end), in no particular order. With spatial
+  // splits a triangle may have several, in different ranges, and slots between ranges are unused.
   const PrimRef* refs() const { return refs_.get(); }
 
   // Computes r's bounds if not yet known.
   void bound(PrimRange& r, bool parallel) const;
   // Splits r (bounding it first) into out[0] and out[1], both bounded, and returns true; or
   // returns false where r is better left a leaf (SAH: at most max_leaf primitives and cheaper
-  // whole; median: at most two) or the build is cancelled.
+  // whole; median: at most two) or the build is cancelled. r's room is shared by the halves in
+  // proportion to their sizes.
   bool split(PrimRange& r, PrimRange (&out)[2], bool parallel);
 
  private:
   struct SahChoice;
+  struct SpatialChoice;
   struct SideCentroids;
   SahChoice sah_split(const PrimRef* refs, const PrimRange& r, bool parallel) const;
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
+  bool split_spatially(PrimRange& r, const SpatialChoice& s, PrimRange (&out)[2]);
+  void share_room(const PrimRange& r, uint32_t mid, PrimRange (&out)[2]);
   template <class Pred>
   void partition(PrimRef* refs, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, SideCentroids& out,
                  const Pred& pred);
 
   BvhBuildOptions options_;
   const Executor& exec_;
-  LargeBuffer<PrimRef> refs_;  // count_ primitives, each range's partitioned in place
-  uint32_t count_ = 0;
+  const Triangle* tris_;       // the scene's, to cut at spatial splits
+  LargeBuffer<PrimRef> refs_;  // capacity_ slots, each range's partitioned in place
+  uint32_t count_ = 0, capacity_ = 0;
+  float root_area_ = 0.0f;  // half area of the root's box, once split
 };
 
 }  // namespace tracer

@@ -26,9 +26,9 @@ class WideBuilder {
   WideBuilder(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
       : scene_(scene), options_(options), exec_(exec), splitter_(scene, options, exec) {
     // Every inner node holds more than one pack's primitives and at least two children, and one
-    // with fewer than eight has only packs below it, so n primitives make fewer than n/2 + 2.
+    // with fewer than eight has only packs below it, so n references make fewer than n/2 + 2.
     // Left uninitialised: only the nodes taken are touched.
-    scratch_ = LargeBuffer<WideNode>(splitter_.count() / 2 + 2);
+    scratch_ = LargeBuffer<WideNode>(splitter_.capacity() / 2 + 2);
   }
 
   // Builds the tree into `nodes` and `packs`; returns the bounds of everything in it.
@@ -200,7 +200,8 @@ class WideBuilder {
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
     : WideBvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
 
-WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec) : scene_(&scene) {
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
+    : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f) {
   BvhBuildOptions options = options_in;
   // Nodes of more than one pack are always split, so the SAH never weighs a leaf larger than one.
   options.max_leaf = std::min(options.max_leaf, kWideWidth);

@@ -35,6 +35,9 @@ struct BvhBuildOptions {
   int threads = 0;   // 0: all hardware threads (parallel modes only)
   int max_leaf = 4;  // SAH: largest leaf; the median split always makes leaves of 1-2
   int bins = 16;     // SAH bins per axis
+  // Spatial splits may add up to this fraction of references (0: none). The 8-wide BVH only: the
+  // binary tree keeps one leaf per triangle.
+  float split_budget = 0.0f;
   // Relative costs for the SAH. 1.5 rather than 1 for a node step: traversal measured the same
   // on every scene (docs/BENCHMARKS.md section 4), with 10-25 % fewer nodes to build and store.
   float traversal_cost = 1.5f;

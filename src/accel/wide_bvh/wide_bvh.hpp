@@ -75,9 +75,12 @@ class WideBvh {
   const PackArray& packs() const { return packs_; }
   const Aabb& bounds() const { return bounds_; }  // of every triangle in the tree
   size_t memory_bytes() const { return nodes_.size() * sizeof(WideNode) + packs_.size() * sizeof(TrianglePack); }
-  // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf,
-  // empty slots come last.
+  // Every child box contains its subtree, every non-degenerate triangle is in exactly one leaf
+  // (with spatial splits: in at least one, and its leaves' boxes together cover its box, each
+  // meeting it), empty slots come last.
   std::string validate() const;
+  // Built with spatial splits (BvhBuildOptions::split_budget): a triangle may be in several leaves.
+  bool spatial_splits() const { return spatial_splits_; }
   const Scene& scene() const { return *scene_; }
 
   // The SIMD target the kernels run on (e.g. "AVX3", "AVX2", "SSE4").
@@ -93,6 +96,7 @@ class WideBvh {
   WideNodeArray nodes_;
   PackArray packs_;
   Aabb bounds_;
+  bool spatial_splits_ = false;
 };
 
 // The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight

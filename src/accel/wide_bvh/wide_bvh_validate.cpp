@@ -1,5 +1,6 @@
 // The 8-wide BVH's validator: every child box contains its subtree, every non-degenerate
-// triangle is in exactly one leaf, empty slots come after the used ones.
+// triangle is in exactly one leaf (with spatial splits: in at least one, its leaves' boxes
+// covering its box), empty slots come after the used ones.
 #include <cmath>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@ std::string WideBvh::validate() const {
     return "";
   }
   std::vector<uint32_t> seen(scene_->size(), 0);
+  std::vector<Aabb> covered(spatial_splits_ ? scene_->size() : 0);  // by its leaves' boxes
   std::vector<uint32_t> visits(nodes_.size(), 0);
   std::vector<uint32_t> stack{0};
   // Every triangle below a child must lie in that child's box; check leaf by leaf.
@@ -52,7 +54,14 @@ std::string WideBvh::validate() const {
           if (k >= scene_->size()) return "pack lane's triangle out of range";
           const Triangle& t = scene_->triangles[k];
           if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
-          if (!box.contains(t.bounds())) return "leaf box does not contain triangle " + std::to_string(k);
+          if (spatial_splits_) {
+            const Aabb tb = t.bounds();
+            const Aabb part{max(box.lo, tb.lo), min(box.hi, tb.hi)};
+            if (part.empty()) return "leaf box misses triangle " + std::to_string(k);
+            covered[k].extend(part);
+          } else if (!box.contains(t.bounds())) {
+            return "leaf box does not contain triangle " + std::to_string(k);
+          }
           ++seen[k];
         }
       } else {
@@ -61,9 +70,11 @@ std::string WideBvh::validate() const {
     }
   }
   for (size_t i = 0; i < seen.size(); ++i) {
-    const uint32_t expected = scene_->triangles[i].degenerate() ? 0 : 1;
-    if (seen[i] != expected)
-      return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
+    const bool degenerate = scene_->triangles[i].degenerate();
+    const bool right = spatial_splits_ ? (seen[i] > 0) != degenerate : seen[i] == (degenerate ? 0u : 1u);
+    if (!right) return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";
+    if (spatial_splits_ && !degenerate && !covered[i].contains(scene_->triangles[i].bounds()))
+      return "the leaves of triangle " + std::to_string(i) + " do not cover it";
   }
   for (size_t i = 0; i < visits.size(); ++i) {
     if (visits[i] != 1) return "node " + std::to_string(i) + " unreachable";
