@@ -93,6 +93,9 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --sched openmp", 2, "--sched: unknown scheduler 'openmp'"},
       {"render --bvh-split middle", 2, "--bvh-split: unknown split 'middle'"},
       {"render --build magic", 2, "--build: unknown builder 'magic'"},
+      {"render --build-quality low", 2, "--build-quality: unknown quality 'low'"},
+      {"render --accel bvh --build-quality high", 2, "--build-quality: only bvh8 and embree build at a quality level"},
+      {"render --accel brute --build-quality medium", 2, "--build-quality: only bvh8 and embree"},
       {"render --no-such-flag", 2, "--no-such-flag"},
       {"frobnicate", 2, "unknown command 'frobnicate'"},
       {"render --width 20000", 2, "--width: must be between 1 and 16384, got 20000"},
@@ -528,6 +531,32 @@ TEST_F(Cli, DefaultIsTheFastestPathWithTheScalarImage) {
   const nlohmann::json k = nlohmann::json::parse(in2);
   EXPECT_EQ(k["accel"], "bvh-sah");
   EXPECT_FALSE(k["packets"].get<bool>()) << "--simd off: no SIMD bundles either";
+}
+
+// The build quality changes the tree, never the image: spatial splits keep every hit exact.
+// Path tracing defaults to high, the other integrators to medium.
+TEST_F(Cli, BuildQualityChangesTheTreeNotTheImage) {
+  const std::string common = " -q --width 32 --height 24";
+  std::string names[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string q = i == 0 ? "medium" : "high";
+    auto r = test::run_tracer("render" + common + " --spp 2 --build-quality " + q + " --stats-json " + dir_ + "/" + q +
+                              ".json -o " + dir_ + "/" + q + ".png");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(dir_ + "/" + q + ".json");
+    names[i] = nlohmann::json::parse(in)["accel"].get<std::string>();
+  }
+  EXPECT_EQ(names[0].find("-high"), std::string::npos) << names[0];
+  EXPECT_NE(names[1].find("-high"), std::string::npos) << names[1];
+  EXPECT_EQ(read_image(dir_ + "/medium.png").rgb, read_image(dir_ + "/high.png").rgb);
+  for (const std::string integrator : {"path", "ao"}) {
+    auto r = test::run_tracer("render" + common + " --integrator " + integrator + " --stats-json " + dir_ +
+                              "/d.json -o " + dir_ + "/d.png");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(dir_ + "/d.json");
+    const std::string name = nlohmann::json::parse(in)["accel"].get<std::string>();
+    EXPECT_EQ(name.find("-high") != std::string::npos, integrator == "path") << integrator << ": " << name;
+  }
 }
 
 TEST_F(Cli, ReadsTheSceneFromStandardInputAndPipes) {

@@ -22,7 +22,8 @@ struct Variant {
   SchedKind sched;
   std::string description;
   bool study;
-  bool packets = false;  // primary rays in 4x4 packets (bvh8), AO rays in bundles (bvh, bvh8)
+  bool packets = false;                         // primary rays in 4x4 packets (bvh8), AO rays in bundles (bvh, bvh8)
+  BuildQuality quality = BuildQuality::Medium;  // bvh8 (Embree's is in its AccelKind)
 };
 
 // The study's ten columns (its ISPC column is simd-brute, our Highway kernels) and ours.

@@ -66,6 +66,7 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
     on_run(run);
     AccelOptions ao;
     ao.kind = v.accel;
+    ao.quality = v.quality;
     ao.bvh.split = v.split;
     ao.bvh.mode = v.build;
     ao.bvh.threads = job.threads;

@@ -134,6 +134,10 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--accel", a.accel,
                  "accelerator: " + names_of<AccelKind>(kAccelKindNames) + " (default " +
                      std::string(name_of<AccelKind>(kAccelKindNames, AccelOptions{}.kind)) + ", the fastest)");
+  app.add_option("--build-quality", a.build_quality,
+                 "bvh8 and embree: " + names_of<BuildQuality>(kBuildQualityNames) +
+                     " (high: spatial splits, a slower build for faster closest hits; default high for "
+                     "--integrator path, medium otherwise and in tracer view)");
   app.add_option("--bvh-split", a.split, "BVH split: " + names_of<BvhSplit>(kBvhSplitNames) + " (the study's)")
       ->capture_default_str();
   app.add_option("--build", a.build, "BVH build: " + names_of<BuildMode>(kBuildModeNames))->capture_default_str();

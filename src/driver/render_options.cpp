@@ -102,6 +102,18 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
   o.bvh.mode = parse_name<BuildMode>(kBuildModeNames, a.build, "--build", "builder");
   o.bvh.threads = a.threads.value_or(0);
+  if (a.build_quality) {
+    o.quality = parse_name<BuildQuality>(kBuildQualityNames, *a.build_quality, "--build-quality", "quality");
+    if (!has_build_quality(o.kind)) throw UsageError("--build-quality: only bvh8 and embree build at a quality level");
+    if (o.kind == AccelKind::EmbreeHigh && o.quality != BuildQuality::High) {
+      throw UsageError("--build-quality " + *a.build_quality + ": --accel embree-high is Embree at high");
+    }
+  } else if (o.kind == AccelKind::Bvh8) {
+    // A path-traced render traces many closest-hit rays per triangle: spatial splits' slower
+    // build pays for itself (docs/BENCHMARKS.md section 19). tracer view asks for medium.
+    o.quality = a.integrator == name_of<Integrator>(kIntegratorNames, Integrator::Path) ? BuildQuality::High
+                                                                                        : BuildQuality::Medium;
+  }
   return o;
 }
 
