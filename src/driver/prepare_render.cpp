@@ -20,6 +20,8 @@ PreparedRender::PreparedRender(const RenderArgs& args, const PrepareOptions& opt
   settings = settings_for(args, scene, lighting_note);
   sched = sched_options_for(args);
   AccelOptions accel_options = accel_options_for(args);
+  if (!args.build_quality && accel_options.kind == AccelKind::Bvh8)
+    accel_options.quality = default_build_quality(settings, args.frames, scene.size());
   accel_options.bvh.cancel = options.cancel;
   accel = build_accelerator(scene, accel_options);
 }

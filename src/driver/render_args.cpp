@@ -136,8 +136,8 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                      std::string(name_of<AccelKind>(kAccelKindNames, AccelOptions{}.kind)) + ", the fastest)");
   app.add_option("--build-quality", a.build_quality,
                  "bvh8 and embree: " + names_of<BuildQuality>(kBuildQualityNames) +
-                     " (high: spatial splits, a slower build for faster closest hits; default high for "
-                     "--integrator path, medium otherwise and in tracer view)");
+                     " (high: spatial splits, a slower build for faster closest hits; default high for a path "
+                     "render of at least 16 pixel samples per triangle, else medium, and medium in tracer view)");
   app.add_option("--bvh-split", a.split, "BVH split: " + names_of<BvhSplit>(kBvhSplitNames) + " (the study's)")
       ->capture_default_str();
   app.add_option("--build", a.build, "BVH build: " + names_of<BuildMode>(kBuildModeNames))->capture_default_str();

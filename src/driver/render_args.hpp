@@ -48,7 +48,7 @@ struct RenderArgs {
   std::optional<double> focus_distance;  // --focus-distance: default the look-at point's
   std::optional<double> ao_distance;
   std::optional<std::string> accel;          // empty: the library's default (scalar bvh with --simd off)
-  std::optional<std::string> build_quality;  // empty: chosen by the integrator (accel_options_for)
+  std::optional<std::string> build_quality;  // empty: chosen by the work (default_build_quality)
   bool packets = false, no_packets = false;  // neither: packets where the accelerator can
   std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
   std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};

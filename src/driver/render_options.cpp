@@ -108,13 +108,15 @@ AccelOptions accel_options_for(const RenderArgs& a) {
     if (o.kind == AccelKind::EmbreeHigh && o.quality != BuildQuality::High) {
       throw UsageError("--build-quality " + *a.build_quality + ": --accel embree-high is Embree at high");
     }
-  } else if (o.kind == AccelKind::Bvh8) {
-    // A path-traced render traces many closest-hit rays per triangle: spatial splits' slower
-    // build pays for itself (docs/BENCHMARKS.md section 19). tracer view asks for medium.
-    o.quality = a.integrator == name_of<Integrator>(kIntegratorNames, Integrator::Path) ? BuildQuality::High
-                                                                                        : BuildQuality::Medium;
   }
   return o;
+}
+
+BuildQuality default_build_quality(const RenderSettings& s, int frames, size_t triangles) {
+  const double samples = double(s.width) * double(s.height) * double(s.spp) * double(frames);
+  return s.integrator == Integrator::Path && samples >= kHighQualitySamplesPerTriangle * double(triangles)
+             ? BuildQuality::High
+             : BuildQuality::Medium;
 }
 
 SchedOptions sched_options_for(const RenderArgs& a) {

@@ -20,7 +20,16 @@ inline constexpr double kDefaultNoiseThreshold = 0.01;
 RenderSettings settings_for(const RenderArgs& args, const Scene& scene, std::string& note);
 // Said whenever a finished image is black in every pixel: why, and the flags that light it.
 std::string black_image_warning(const RenderSettings& settings, const Scene& scene);
+// The accelerator the flags ask for; its quality is --build-quality's, else medium (see below).
 AccelOptions accel_options_for(const RenderArgs& args);
+
+// The 8-wide BVH's quality when --build-quality is not given: high for a path-traced render of at
+// least kHighQualitySamplesPerTriangle pixel samples per triangle, medium otherwise. High's spatial
+// splits cost about 0.4 us more build per triangle and save about 0.2 us per path sample (Sponza,
+// Sibenik; docs/BENCHMARKS.md section 19), so a short render (a --spp 1 preview of a large scene,
+// an AO or whitted image) keeps the faster build. tracer view asks for medium.
+inline constexpr double kHighQualitySamplesPerTriangle = 16.0;
+BuildQuality default_build_quality(const RenderSettings& settings, int frames, size_t triangles);
 SchedOptions sched_options_for(const RenderArgs& args);
 SimdTarget simd_target_for(const RenderArgs& args);
 ExrPixel exr_pixel_for(const RenderArgs& args);
