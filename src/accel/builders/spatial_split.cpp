@@ -94,7 +94,11 @@ void clip_triangle(const Triangle& tri, const Aabb& box, int axis, float pos, Aa
   right = r.empty() ? Aabb{} : r.aabb();
 }
 
-int SpatialSplit::slab(float x) const { return static_cast<int>(std::clamp((x - lo) / width, 0.0f, float(bins - 1))); }
+int SpatialSplit::slab(float x) const {
+  const float f = (x - lo) / width;
+  if (!(f > 0.0f)) return 0;  // also NaN: never converted
+  return f >= float(bins - 1) ? bins - 1 : static_cast<int>(f);
+}
 
 SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint32_t begin, uint32_t end,
                                 const Aabb& box, int bins) {
@@ -108,6 +112,7 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
     s.bins = bins;
     s.lo = box.lo[a];
     s.width = extent / float(bins);
+    if (!(s.width > 0.0f)) continue;  // an extent of a few denormals
     const __m128 off_axis = off_axis_mask(a);
     Box4 slab_box[kMaxSpatialBins];
     uint32_t enter[kMaxSpatialBins] = {}, exit[kMaxSpatialBins] = {};
