@@ -37,14 +37,8 @@ struct Bounds4 {
     clo = _mm_min_ps(clo, o.clo);
     chi = _mm_max_ps(chi, o.chi);
   }
-  static Aabb to_aabb(__m128 l, __m128 h) {
-    alignas(16) float a[4], b[4];
-    _mm_store_ps(a, l);
-    _mm_store_ps(b, h);
-    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
-  }
-  Aabb box() const { return to_aabb(lo, hi); }
-  Aabb centroids() const { return to_aabb(clo, chi); }
+  Aabb box() const { return SseBox::to_aabb(lo, hi); }
+  Aabb centroids() const { return SseBox::to_aabb(clo, chi); }
 };
 
 // Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
@@ -255,8 +249,8 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
                   [&](const PrimRef& prim) { return binner(prim.center(sah.axis), sah.axis) < sah.split_bin; });
         out[0].box = sah.left_box;
         out[1].box = sah.right_box;
-        out[0].cbox = Bounds4::to_aabb(centroids.llo, centroids.lhi);
-        out[1].cbox = Bounds4::to_aabb(centroids.rlo, centroids.rhi);
+        out[0].cbox = SseBox::to_aabb(centroids.llo, centroids.lhi);
+        out[1].cbox = SseBox::to_aabb(centroids.rlo, centroids.rhi);
         halves_known = true;
       }
     }
@@ -403,8 +397,8 @@ PrimSplitter::SahChoice PrimSplitter::sah_split(const PrimRef* refs, const PrimR
     r.reset();
     for (int b = 0; b < best.split_bin; ++b) l.add(bins.bins[best.axis][b]);
     for (int b = best.split_bin; b < nb; ++b) r.add(bins.bins[best.axis][b]);
-    best.left_box = Bounds4::to_aabb(l.lo, l.hi);
-    best.right_box = Bounds4::to_aabb(r.lo, r.hi);
+    best.left_box = SseBox::to_aabb(l.lo, l.hi);
+    best.right_box = SseBox::to_aabb(r.lo, r.hi);
   }
   best.bins = nb;
   return best;

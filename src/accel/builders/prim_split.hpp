@@ -20,6 +20,27 @@
 
 namespace tracer {
 
+// A box in two SSE registers (lane 3 unused), as the builders bin, sweep and cut boxes.
+struct SseBox {
+  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  void extend(__m128 p) {
+    lo = _mm_min_ps(lo, p);
+    hi = _mm_max_ps(hi, p);
+  }
+  void extend(const SseBox& b) {
+    lo = _mm_min_ps(lo, b.lo);
+    hi = _mm_max_ps(hi, b.hi);
+  }
+  bool empty() const { return (_mm_movemask_ps(_mm_cmpgt_ps(lo, hi)) & 7) != 0; }
+  Aabb aabb() const { return to_aabb(lo, hi); }
+  static Aabb to_aabb(__m128 lo, __m128 hi) {
+    alignas(16) float a[4], b[4];
+    _mm_store_ps(a, lo);
+    _mm_store_ps(b, hi);
+    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
+  }
+};
+
 // One primitive as the builder moves it around: its box in two SSE registers, the triangle's
 // scene index in the otherwise unused fourth lane of `lo`. Binning and partitioning stream
 // through one array of these, so no pass gathers from per-triangle arrays in random order.
@@ -43,12 +64,7 @@ struct alignas(32) PrimRef {
     return _mm_cvtss_f32(_mm_shuffle_ps(c, c, _MM_SHUFFLE(Axis, Axis, Axis, Axis)));
   }
   float center(int axis) const { return axis == 0 ? center<0>() : axis == 1 ? center<1>() : center<2>(); }
-  Aabb box() const {
-    alignas(16) float a[4], b[4];
-    _mm_store_ps(a, lo);
-    _mm_store_ps(b, hi);
-    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
-  }
+  Aabb box() const { return SseBox::to_aabb(lo, hi); }
 };
 static_assert(sizeof(PrimRef) == 32);
 

@@ -10,32 +10,12 @@ namespace {
 // 2^-20: about eight units in the last place of a float, far above the cut points' rounding.
 constexpr float kWiden = 1.0f / 1048576.0f;
 
-// A box in two SSE registers (lane 3 unused), as the binning handles them.
-struct Box4 {
-  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
-  void extend(__m128 p) {
-    lo = _mm_min_ps(lo, p);
-    hi = _mm_max_ps(hi, p);
-  }
-  void extend(const Box4& b) {
-    lo = _mm_min_ps(lo, b.lo);
-    hi = _mm_max_ps(hi, b.hi);
-  }
-  bool empty() const { return (_mm_movemask_ps(_mm_cmpgt_ps(lo, hi)) & 7) != 0; }
-  Aabb aabb() const {
-    alignas(16) float a[4], b[4];
-    _mm_store_ps(a, lo);
-    _mm_store_ps(b, hi);
-    return Aabb{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
-  }
-  static Box4 of(const Aabb& b) {
-    return {_mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, 0.0f), _mm_setr_ps(b.hi.x, b.hi.y, b.hi.z, 0.0f)};
-  }
-  static Box4 of(const PrimRef& r) {
-    const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
-    return {_mm_and_ps(r.lo, xyz), r.hi};
-  }
-};
+SseBox sse_box(const Aabb& b) {
+  return {_mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, 0.0f), _mm_setr_ps(b.hi.x, b.hi.y, b.hi.z, 0.0f)};
+}
+SseBox sse_box(const PrimRef& r) {  // without the id in lo's lane 3
+  return {_mm_and_ps(r.lo, _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0))), r.hi};
+}
 
 struct Corners {
   __m128 v[3];
@@ -50,14 +30,14 @@ struct Corners {
 };
 
 // Widens a cut part by kWiden of the box's magnitude (not along the cut axis) and keeps it in the box.
-Box4 clamp_to(Box4 part, const Box4& box, __m128 off_axis) {
-  if (part.empty()) return Box4{};
+SseBox clamp_to(SseBox part, const SseBox& box, __m128 off_axis) {
+  if (part.empty()) return SseBox{};
   const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   const __m128 m = _mm_and_ps(
       _mm_mul_ps(_mm_max_ps(_mm_and_ps(box.lo, abs), _mm_and_ps(box.hi, abs)), _mm_set1_ps(kWiden)), off_axis);
   part.lo = _mm_max_ps(_mm_sub_ps(part.lo, m), box.lo);
   part.hi = _mm_min_ps(_mm_add_ps(part.hi, m), box.hi);
-  return part.empty() ? Box4{} : part;
+  return part.empty() ? SseBox{} : part;
 }
 
 __m128 off_axis_mask(int axis) {
@@ -66,8 +46,8 @@ __m128 off_axis_mask(int axis) {
   return _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(m)));
 }
 
-void clip(const Corners& c, const Box4& box, int axis, float pos, __m128 off_axis, Box4& left, Box4& right) {
-  Box4 l, r;
+void clip(const Corners& c, const SseBox& box, int axis, float pos, __m128 off_axis, SseBox& left, SseBox& right) {
+  SseBox l, r;
   const __m128 plane = _mm_set1_ps(pos);
   for (int i = 0; i < 3; ++i) {
     const int j = i == 2 ? 0 : i + 1;
@@ -88,8 +68,8 @@ void clip(const Corners& c, const Box4& box, int axis, float pos, __m128 off_axi
 }  // namespace
 
 void clip_triangle(const Triangle& tri, const Aabb& box, int axis, float pos, Aabb& left, Aabb& right) {
-  Box4 l, r;
-  clip(Corners(tri), Box4::of(box), axis, pos, off_axis_mask(axis), l, r);
+  SseBox l, r;
+  clip(Corners(tri), sse_box(box), axis, pos, off_axis_mask(axis), l, r);
   left = l.empty() ? Aabb{} : l.aabb();
   right = r.empty() ? Aabb{} : r.aabb();
 }
@@ -114,10 +94,10 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
     s.width = extent / float(bins);
     if (!(s.width > 0.0f)) continue;  // an extent of a few denormals
     const __m128 off_axis = off_axis_mask(a);
-    Box4 slab_box[kMaxSpatialBins];
+    SseBox slab_box[kMaxSpatialBins];
     uint32_t enter[kMaxSpatialBins] = {}, exit[kMaxSpatialBins] = {};
     for (uint32_t i = begin; i < end; ++i) {
-      const Box4 rb = Box4::of(refs[i]);
+      const SseBox rb = sse_box(refs[i]);
       const int b0 = s.slab(refs[i].lo[a]), b1 = s.slab(refs[i].hi[a]);
       ++enter[b0];
       ++exit[b1];
@@ -127,9 +107,9 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
       }
       // Cut the reference at each slab edge it crosses, left to right.
       const Corners corners(tris[refs[i].id()]);
-      Box4 rest = rb;
+      SseBox rest = rb;
       for (int b = b0; b < b1 && !rest.empty(); ++b) {
-        Box4 part, next;
+        SseBox part, next;
         clip(corners, rest, a, s.lo + s.width * float(b + 1), off_axis, part, next);
         slab_box[b].extend(part);  // an empty part changes nothing
         rest = next;
@@ -139,7 +119,7 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
     // Sweep: references entering slabs left of the plane go left, those leaving right of it go right.
     float right_area[kMaxSpatialBins];
     uint32_t right_count[kMaxSpatialBins];
-    Box4 acc;
+    SseBox acc;
     uint32_t n = 0;
     for (int b = bins - 1; b > 0; --b) {
       acc.extend(slab_box[b]);
@@ -147,7 +127,7 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
       right_area[b] = acc.aabb().half_area();
       right_count[b] = n;
     }
-    acc = Box4{};
+    acc = SseBox{};
     n = 0;
     for (int b = 1; b < bins; ++b) {
       acc.extend(slab_box[b - 1]);
@@ -160,7 +140,7 @@ SpatialSplit find_spatial_split(const Triangle* tris, const PrimRef* refs, uint3
         s.left_count = n;
         s.right_count = right_count[b];
         best = s;
-        Box4 l, r;
+        SseBox l, r;
         for (int k = 0; k < bins; ++k) (k < b ? l : r).extend(slab_box[k]);
         best.left_box = l.aabb();
         best.right_box = r.aabb();
