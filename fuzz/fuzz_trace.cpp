@@ -1,6 +1,6 @@
 // libFuzzer target for the whole path a render walks: load an OBJ (the input), build every
-// accelerator over it, and trace a few rays derived from the input through each. Every
-// accelerator must give brute force's occlusion answer and closest hit bit for bit, or a real
+// accelerator over it (the 8-wide BVH at both build qualities, each validated), and trace a few rays derived from the
+// input through each. Every accelerator must give brute force's occlusion answer and closest hit bit for bit, or a real
 // hit that rounding made a near tie (see same()), as the README says; a mismatch, a crash or a
 // non-InputError exception is a finding.
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <cstring>
 #include <iterator>
 #include <string>
+#include <variant>
 
 #include "accel/accelerator.hpp"
 #include "accel/kernels/triangle_test.hpp"
@@ -94,12 +95,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   if (!std::isfinite(length(scene.bounds.extent()))) return 0;
   const BruteForce reference(scene);
-  AccelOptions sah{.kind = AccelKind::Bvh}, median{.kind = AccelKind::Bvh}, wide, simd;
+  AccelOptions sah{.kind = AccelKind::Bvh}, median{.kind = AccelKind::Bvh}, wide, wide_high, simd;
   median.bvh.split = BvhSplit::Median;
-  wide.kind = AccelKind::Bvh8;
+  wide.kind = wide_high.kind = AccelKind::Bvh8;
+  wide_high.quality = BuildQuality::High;  // spatial splits: references cut to their triangle's part
   simd.kind = AccelKind::BruteSimd;
   const Accelerator accels[] = {build_accelerator(scene, sah), build_accelerator(scene, median),
-                                build_accelerator(scene, wide), build_accelerator(scene, simd)};
+                                build_accelerator(scene, wide), build_accelerator(scene, wide_high),
+                                build_accelerator(scene, simd)};
+  for (const Accelerator& a : accels) {
+    if (const auto* w = std::get_if<WideBvh>(a.impl.get())) {
+      if (const std::string bad = w->validate(); !bad.empty()) {
+        std::fprintf(stderr, "fuzz_trace: %s tree invalid: %s\n", a.name.c_str(), bad.c_str());
+        std::abort();
+      }
+    }
+  }
   // Rays from the input's bytes, cycling over them; always a few, even from a short input.
   uint8_t window[24];
   for (size_t k = 0; k < 16; ++k) {
