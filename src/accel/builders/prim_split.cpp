@@ -121,8 +121,6 @@ uint32_t median_partition(PrimRef* refs, uint32_t begin, uint32_t end) {
 
 }  // namespace
 
-struct PrimSplitter::SpatialChoice : SpatialSplit {};
-
 struct PrimSplitter::SahChoice {
   int axis = -1;
   int split_bin = 0;
@@ -231,11 +229,11 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
         if (count <= uint32_t(options_.max_leaf)) return false;
         mid = median_split(refs, begin, end, max_dimension(extent));
       } else {
-        SpatialChoice spatial;
+        SpatialSplit spatial;
         if (node.room > 0) {
           Aabb overlap{max(sah.left_box.lo, sah.right_box.lo), min(sah.left_box.hi, sah.right_box.hi)};
           if (overlap.half_area() > kSpatialOverlap * root_area_)
-            static_cast<SpatialSplit&>(spatial) = find_spatial_split(tris_, refs, begin, end, node.box, sah.bins);
+            spatial = find_spatial_split(tris_, refs, begin, end, node.box, sah.bins);
         }
         const float raw = std::min(sah.raw, spatial.raw);
         const float cost = options_.traversal_cost + options_.intersection_cost * raw * sah.inv_area;
@@ -282,7 +280,7 @@ void PrimSplitter::share_room(const PrimRange& r, uint32_t mid, PrimRange (&out)
 
 // Cuts r at a spatial split, writing each side's references to its part of r's slots; false
 // (r untouched) where a side would be empty or the references would not fit r's room.
-bool PrimSplitter::split_spatially(PrimRange& r, const SpatialChoice& s, PrimRange (&out)[2]) {
+bool PrimSplitter::split_spatially(PrimRange& r, const SpatialSplit& s, PrimRange (&out)[2]) {
   std::vector<PrimRef> left, right;
   divide_spatially(tris_, refs_.get(), r.begin, r.end, s, left, right);
   const uint64_t total = left.size() + right.size(), slots = uint64_t(r.size()) + r.room;

@@ -20,6 +20,8 @@
 
 namespace tracer {
 
+struct SpatialSplit;  // spatial_split.hpp
+
 // A box in two SSE registers (lane 3 unused), as the builders bin, sweep and cut boxes.
 struct SseBox {
   __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
@@ -107,11 +109,10 @@ class PrimSplitter {
 
  private:
   struct SahChoice;
-  struct SpatialChoice;
   struct SideCentroids;
   SahChoice sah_split(const PrimRef* refs, const PrimRange& r, bool parallel) const;
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
-  bool split_spatially(PrimRange& r, const SpatialChoice& s, PrimRange (&out)[2]);
+  bool split_spatially(PrimRange& r, const SpatialSplit& s, PrimRange (&out)[2]);
   void share_room(const PrimRange& r, uint32_t mid, PrimRange (&out)[2]);
   template <class Pred>
   void partition(PrimRef* refs, uint32_t begin, uint32_t end, uint32_t mid, bool parallel, SideCentroids& out,
