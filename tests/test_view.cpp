@@ -448,6 +448,20 @@ TEST_F(ViewServerTest, ASecondServerOnThePortIsRefused) {
   EXPECT_THROW(second.bind("127.0.0.1", port_), UsageError);
 }
 
+// A stop that comes before the listening thread has begun, or while it begins, is not lost:
+// cpp-httplib's own stop() does nothing until its accept loop runs. Repeated, since the window
+// is a few microseconds; a lost stop hangs here (ctest's timeout names the test).
+TEST_F(ViewServerTest, AStopBeforeOrDuringListenIsNotLost) {
+  for (int i = 0; i < 200; ++i) {
+    view::ViewServer early(*session_, "fedcba9876543210fedcba9876543210");
+    early.bind("127.0.0.1", 0);
+    if (i % 2 == 0) early.stop();  // before listen() is called at all
+    std::thread listening([&] { early.listen(); });
+    if (i % 2 == 1) early.stop();  // while it starts
+    listening.join();
+  }
+}
+
 TEST(ViewCommand, BadFlagsAreRefused) {
   for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
            {"view --port 70000", "--port"},

@@ -34,8 +34,7 @@ using namespace driver;  // the flags, signals and statistics both binaries shar
 namespace {
 
 int cmd_render(const RenderArgs& args) {
-  // Installed first, so a signal during loading or the build is not lost: both poll the flag.
-  install_stop_handlers();
+  // main() installed the flag handlers: loading, the build and the render poll the flag.
   const CancelFlag cancel = &stop_requested();
   const PreparedRender setup(args, {.writes_outputs = true, .quiet = args.quiet, .cancel = cancel});
   if (args.threads && ThreadLimit::oversubscribed(*args.threads)) {
@@ -138,6 +137,7 @@ int main(int argc, char** argv) {
   using namespace tracer;
   using namespace tracer::cli;
   using namespace tracer::driver;
+  install_stop_handlers();  // first: see signals.hpp
   CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ, glTF 2.0 and PLY scenes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "tracer 0.1.0");
@@ -211,6 +211,8 @@ int main(int argc, char** argv) {
       view_args.user_flags.assign(argv + 2, argv + argc);
       return view::run_view(std::move(view_args));
     }
+    // Nothing polls the stop flag in these: a signal ends them at once.
+    if (info->parsed() || bench->parsed() || compare->parsed()) install_immediate_stop_handlers(nullptr);
     if (info->parsed()) return cmd_info(info_args);
     if (bench->parsed()) return run_bench(bench_args);
     if (compare->parsed()) return cmd_compare(compare_a, compare_b, compare_exposure);

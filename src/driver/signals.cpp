@@ -42,6 +42,7 @@ void install_immediate_stop_handlers(const char* message) {
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+  if (const int sig = g_signal.load()) on_immediate_stop_signal(sig);
 }
 
 void install_stop_handlers() {

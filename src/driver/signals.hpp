@@ -8,11 +8,16 @@
 
 namespace tracer::driver {
 
+// The flag handlers. main() installs them first of all, so that a signal is never lost while
+// the process starts: a shell without job control starts a background job with SIGINT ignored,
+// and one that came before this call went with that. Each command then keeps them (it polls the
+// flag) or, where nothing polls it, asks for the immediate ones.
 void install_stop_handlers();
 // For a process that cannot stop cleanly on its own (a rank of an MPI job, whose peers the
 // runtime is already tearing down): the first SIGINT, SIGTERM or SIGHUP writes `message` (if not
 // null) to stderr, removes the temporary file of a write in progress and exits 128 + the signal
-// at once. `message` must outlive the process.
+// at once. `message` must outlive the process. A stop that came before this call ends the
+// process here, the same way.
 void install_immediate_stop_handlers(const char* message);
 const std::atomic<bool>& stop_requested();
 int stop_signal();               // the first signal received, 0 if none

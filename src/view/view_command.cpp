@@ -18,7 +18,6 @@ namespace tracer::view {
 
 int run_view(ViewArgs args) {
   using namespace driver;
-  install_stop_handlers();
   std::signal(SIGPIPE, SIG_IGN);  // a closed tab is a failed write, not the end of the process
   const CancelFlag cancel = &stop_requested();
   RenderArgs& r = args.render;

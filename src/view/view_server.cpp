@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "base/errors.hpp"
 #include "io/exr_io.hpp"
@@ -253,11 +254,23 @@ int ViewServer::bind(const std::string& host, int port) {
   return bound;
 }
 
-void ViewServer::listen() { server_->listen_after_bind(); }
+void ViewServer::listen() {
+  // listening_ is raised before stopping_ is read and stop() raises stopping_ before it reads
+  // listening_ (both sequentially consistent): either this sees the stop, or stop() sees this
+  // listen and repeats cpp-httplib's stop until the loop has begun and ended.
+  listening_ = true;
+  if (!stopping_) server_->listen_after_bind();
+  listening_ = false;
+}
 
 void ViewServer::stop() {
+  stopping_ = true;
   session_.frames().close();
   server_->stop();
+  while (listening_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    server_->stop();
+  }
 }
 
 void ViewServer::add_routes() {

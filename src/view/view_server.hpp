@@ -45,9 +45,10 @@ class ViewServer {
 
   // Binds host:port (port 0: any free port); returns the port. Throws UsageError if it cannot.
   int bind(const std::string& host, int port);
-  // Serves until stop(); call after bind().
+  // Serves until stop(); call after bind(). Returns at once if stop() came first.
   void listen();
-  // Ends every event stream and the listening; listen() returns.
+  // Ends every event stream and the listening; listen() returns. Safe from any thread at any
+  // time, before listen() has started too: it waits until a listen in progress has returned.
   void stop();
   const std::string& token() const { return token_; }
 
@@ -57,6 +58,10 @@ class ViewServer {
   const std::string token_;
   std::unique_ptr<GuardedServer> server_;
   std::atomic<int> streams_{0};
+  // cpp-httplib's stop() does nothing before its listen loop has begun, so a stop that came
+  // between bind() and that moment was lost and listen() blocked in accept for ever.
+  std::atomic<bool> stopping_{false};
+  std::atomic<bool> listening_{false};
 };
 
 }  // namespace tracer::view
