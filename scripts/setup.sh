@@ -11,7 +11,7 @@ PACKAGES=(
   libtinyobjloader-dev libfast-float-dev libstb-dev libcli11-dev libtbb-dev libhwy-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev zlib1g-dev
   libclang-rt-14-dev llvm clang-format nlohmann-json3-dev libopenexr-dev
-  libopenmpi-dev openmpi-bin libcpp-httplib-dev libtinygltf-dev
+  libopenmpi-dev openmpi-bin libcpp-httplib-dev libtinygltf-dev libssl-dev
   chromium  # tracer view's browser test (headless)
 )
 # Node.js and npm for the browser test's playwright-core: Debian's, unless a node with npm is

@@ -262,6 +262,104 @@ TEST(Gltf, HostileFilesFailWithOneLineNamingTheFile) {
   EXPECT_EQ(load_error("glTF\x02\0\0\0\xff\xff\xff\x7f").rfind("t.gltf: ", 0), 0u);
 }
 
+// What tinygltf would read as absent, or let through, is named: the property, its value and why.
+TEST(Gltf, WronglyTypedOrOutOfRangePropertiesAreNamed) {
+  const auto with = [](std::string from, const std::string& old, const std::string& replacement) {
+    const size_t at = from.find(old);
+    EXPECT_NE(at, std::string::npos) << old;
+    return at == std::string::npos ? from : from.replace(at, old.size(), replacement);
+  };
+  const std::string base = TinyGltf{}.json();
+  const auto node = [](const std::string& n) {
+    TinyGltf g;
+    g.node = n;
+    return g.json();
+  };
+  const auto top = [](const std::string& e) {
+    TinyGltf g;
+    g.extra = e;
+    return g.json();
+  };
+  const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+  const std::string camera = R"("cameras": [{"type": "perspective", "perspective": )";
+  const std::pair<std::string, std::string> cases[] = {
+      {top(R"("extras": )" + deep + ", "), "t.gltf: its JSON nests deeper than 256 levels (at byte "},
+      {with(base, R"("bufferView": 0, )", R"("bufferView": 0, "byteOffset": -12, )"),
+       "t.gltf: accessors[0].byteOffset: -12 is not a non-negative integer"},
+      {with(base, R"("bufferView": 0, )", R"("bufferView": 0, "byteOffset": 1.5, )"),
+       "t.gltf: accessors[0].byteOffset: 1.5 is not a non-negative integer"},
+      {top(R"("extensionsRequired": "KHR_materials_ior", )"),
+       "t.gltf: extensionsRequired: \"KHR_materials_ior\" is not an array"},
+      {node(R"({"mesh": 0, "scale": ["nan", 1, 1]})"), "t.gltf: nodes[0].scale[0]: \"nan\" is not a finite number"},
+      {node(R"({"mesh": 0, "matrix": [1, 0, 0]})"), "t.gltf: nodes[0].matrix: 3 numbers, not 16"},
+      {node(R"({"mesh": 0, "matrix": [1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]})"),
+       "t.gltf: nodes[0].matrix: not affine (its last row is not 0 0 0 1)"},
+      {with(base, R"("scene": 0)", R"("scene": 5)"), "t.gltf: scene: 5 names no scene (the file has 1)"},
+      {with(base, R"("scene": 0)", R"("scene": -5)"), "t.gltf: scene: -5 is not a non-negative integer"},
+      {with(base, R"("componentType": 5126)", R"("componentType": 5125)"),
+       "t.gltf: mesh 0 'tri' primitive 0 POSITION (accessor 0): component type 5125 (UNSIGNED_INT) is not allowed"},
+      {with(base, R"("byteLength": 44})", R"("byteLength": 50})"),
+       "t.gltf: buffers[0]: its data: URI holds 44 bytes, its byteLength says 50"},
+      {node(R"({"mesh": 0, "camera": 0})").replace(0, 1, "{" + camera + R"({"znear": 0.1}}], )"),
+       "t.gltf: cameras[0].perspective.yfov: missing"},
+      {node(R"({"mesh": 0, "camera": 0})").replace(0, 1, "{" + camera + R"({"yfov": 1e300, "znear": 0.1}}], )"),
+       "t.gltf: camera 0: yfov 1e+300 ("},
+      {node(R"({"mesh": 0, "camera": 0})").replace(0, 1, "{" + camera + R"({"yfov": 1e-30, "znear": 0.1}}], )"),
+       "t.gltf: camera 0: yfov 1e-30 (5.72958e-29 degrees) is not in [0.001, 179] degrees"},
+  };
+  for (const auto& [json, expect] : cases) {
+    const std::string e = load_error(json);
+    EXPECT_EQ(e.rfind(expect, 0), 0u) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  // One rule per quantity: glTF's emission is held to MTL's limit for Ke.
+  TinyGltf bright;
+  bright.extra = R"("extensionsUsed": ["KHR_materials_emissive_strength"], )";
+  bright.material =
+      R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e38}}})";
+  EXPECT_EQ(load_error(bright.json())
+                .rfind("t.gltf: material 'material 0': emission 1e+38 (emissiveFactor x "
+                       "emissiveStrength) above 1e+06",
+                       0),
+            0u)
+      << load_error(bright.json());
+  // A GLB of another version than 2.
+  for (const uint32_t version : {1u, 3u}) {
+    std::string glb = "glTF";
+    glb.append(reinterpret_cast<const char*>(&version), 4);
+    glb += std::string(12, '\0');
+    EXPECT_EQ(load_error(glb),
+              "t.gltf: GLB version " + std::to_string(version) + ": tracer reads glTF 2.0 (version 2)");
+  }
+  // A perspective camera without the znear tracer never uses loads, with a warning.
+  std::vector<std::string> warnings;
+  const std::string no_znear = node(R"({"mesh": 0, "camera": 0})").replace(0, 1, "{" + camera + R"({"yfov": 0.8}}], )");
+  const Scene s = load_gltf_from_memory(no_znear, "t.gltf", [&](const std::string& w) { warnings.push_back(w); });
+  EXPECT_EQ(s.cameras.size(), 1u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("cameras[0].perspective: no znear"), std::string::npos) << warnings[0];
+}
+
+// Buffer URIs that name no file inside the folder say so, whether or not such a file exists.
+TEST(Gltf, AbsoluteSchemeAndShellUrisAreRefusedAsSuch) {
+  const std::string root = test::temp_dir();
+  for (const std::string uri : {"/dev/zero", "/proc/self/environ", "file:///etc/passwd", "~/x.bin", "$HOME/x.bin"}) {
+    TinyGltf g;
+    g.buffer_uri = uri;
+    std::ofstream(root + "/t.gltf") << g.json();
+    std::string e;
+    try {
+      load_gltf(root + "/t.gltf");
+    } catch (const InputError& error) {
+      e = error.what();
+    }
+    EXPECT_NE(e.find("buffers[0].uri: '" + uri + "' is refused: a URI names a file inside the scene's folder"),
+              std::string::npos)
+        << e;
+  }
+  fs::remove_all(root);
+}
+
 TEST(Gltf, ExternalFilesMustLieInsideTheScenesFolder) {
   const std::string root = test::temp_dir();
   fs::create_directories(root + "/scene/textures");

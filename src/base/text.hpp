@@ -52,6 +52,13 @@ inline std::string in_quotes(std::string_view tok) {
   return "'" + escaped(tok.substr(0, 40)) + (tok.size() > 40 ? "...'" : "'");
 }
 
+// A number for a message, in at most six significant digits ("1e+300", not 300 digits).
+inline std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 // Calls fn(line, number) for every line, numbered from 1, split at "\n", "\r\n" and a lone "\r"
 // (as the OBJ parser splits them, and as old Mac exporters end lines).
 template <class Fn>

@@ -20,6 +20,7 @@
 #include "parallel/executor.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
+#include "scene/value_limits.hpp"
 #include "scene/views.hpp"
 
 namespace tracer::driver {
@@ -183,13 +184,13 @@ void validate(const RenderArgs& a) {
     }
   }
   if (a.ao_distance) check_range_real("--ao-distance", *a.ao_distance, 0.0, 1e30, LowEnd::Open);
-  if (a.fov) check_range_real("--fov", *a.fov, 1e-3, 179.0);
+  if (a.fov) check_range_real("--fov", *a.fov, kMinFovDegrees, kMaxFovDegrees);
   if (a.aperture) check_range_real("--aperture", *a.aperture, 0.0, 1e6);
   if (a.focus_distance) check_range_real("--focus-distance", *a.focus_distance, 0.0, 1e12, LowEnd::Open);
   check_range_real("--ambient", s.ambient, 0.0, 1e6);
   check_range_real("--exposure", s.exposure, 0.0, 1e6, LowEnd::Open);
   check_range("--builtin-spheres", a.scene.builtin_spheres, 0, 10'000'000);
-  if (a.scene.light_intensity) check_range_real("--light-intensity", *a.scene.light_intensity, 0.0, 1e30);
+  if (a.scene.light_intensity) check_range_real("--light-intensity", *a.scene.light_intensity, 0.0, kMaxLightIntensity);
   if (a.threads) check_range("--threads", *a.threads, 1, 1024);
   check_range("--tile", a.sched.tile, 1, 4096);
   check_range("--block", a.sched.block, 1, 1 << 20);

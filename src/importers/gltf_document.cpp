@@ -5,6 +5,7 @@
 
 #include "base/read_input.hpp"
 #include "base/text.hpp"
+#include "importers/gltf_json.hpp"
 
 namespace tracer::gltf {
 namespace {
@@ -18,7 +19,13 @@ struct FileAccess {
   fs::path root;
   uint64_t max_bytes = 0;
   CancelFlag cancel = nullptr;
+  std::vector<std::vector<unsigned char>>* payloads = nullptr;  // buffers' data: URIs, decoded apart
   mutable std::string refused;  // why the last file could not be read (tinygltf wraps it)
+  // The payload a (joined) path names, if any.
+  std::vector<unsigned char>* payload(const std::string& path) const {
+    const std::optional<size_t> k = payload_index(path);
+    return payloads && k && *k < payloads->size() ? &(*payloads)[*k] : nullptr;
+  }
   // The file inside the root `path` names, or nothing with `why` set.
   std::optional<fs::path> inside(const std::string& path, std::string* why) const {
     if (root.empty()) {
@@ -39,6 +46,7 @@ struct FileAccess {
 // Whether it exists at all: reading it then says when it lies outside the folder.
 bool file_exists(const std::string& path, void* user) {
   const auto* access = static_cast<const FileAccess*>(user);
+  if (access->payload(path)) return true;
   std::error_code ec;
   return !access->root.empty() && fs::exists(path, ec);
 }
@@ -48,6 +56,11 @@ std::string expand_file_path(const std::string& path, void*) { return path; }
 
 bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   const auto* access = static_cast<const FileAccess*>(user);
+  if (std::vector<unsigned char>* payload = access->payload(path)) {
+    out->swap(*payload);  // handed over, never copied: tinygltf swaps it into the buffer
+    payload->clear();
+    return true;
+  }
   const std::optional<fs::path> file = access->inside(path, &access->refused);
   if (!file) return false;
   try {
@@ -134,8 +147,11 @@ bool supported_extension(const std::string& ext) {
 tg::Model parse(std::string_view bytes, const std::string& name, const fs::path& base_dir, const LoadLimits& limits,
                 CancelFlag cancel, WarningLog& warnings) {
   if (bytes.size() > UINT32_MAX) throw InputError(name + ": larger than the 4 GiB a glTF file may be");
+  PreparedJson prepared = prepare_json(bytes, name, warnings, cancel);
+  if (!prepared.text.empty()) bytes = prepared.text;
   FileAccess access;
   if (!base_dir.empty()) access = {fs::weakly_canonical(base_dir), limits.max_obj_bytes, cancel};
+  access.payloads = &prepared.payloads;
   tg::TinyGLTF reader;
   reader.SetFsCallbacks({&file_exists, &expand_file_path, &read_whole_file, &refuse_write, &access});
   reader.SetImageLoader(&keep_encoded, nullptr);
@@ -207,6 +223,12 @@ Elements elements(const tg::Model& model, int accessor, const std::string& what)
 
 Elements vectors(const tg::Model& model, int accessor, int components, const std::string& what) {
   const Elements e = elements(model, accessor, what);
+  // glTF allows float attributes, and (KHR_mesh_quantization) 8- and 16-bit integers; a 32-bit
+  // integer attribute is not valid and would read as nothing.
+  if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+    throw InputError(what + " (accessor " + std::to_string(accessor) +
+                     "): component type 5125 (UNSIGNED_INT) is not allowed for a vertex attribute");
+  }
   if (e.components != components) {
     throw InputError(what + " (accessor " + std::to_string(accessor) + "): " + std::to_string(e.components) +
                      " components, not " + std::to_string(components));

@@ -15,6 +15,7 @@
 #include "importers/gltf_document.hpp"
 #include "importers/gltf_materials.hpp"
 #include "importers/indexed_mesh.hpp"
+#include "scene/value_limits.hpp"
 
 namespace tracer {
 namespace {
@@ -309,9 +310,11 @@ class GltfScene {
                     ": only perspective cameras are used");
       return;
     }
-    const double yfov = c.perspective.yfov;
-    if (!(yfov > 0.0 && yfov < std::numbers::pi)) {
-      throw error("camera " + std::to_string(index) + ": yfov " + std::to_string(yfov) + " is not in (0, pi)");
+    const double yfov = c.perspective.yfov, degrees = yfov * 180.0 / std::numbers::pi;
+    if (!(degrees >= kMinFovDegrees && degrees <= kMaxFovDegrees)) {
+      throw error("camera " + std::to_string(index) + ": yfov " + format_number(yfov) + " (" + format_number(degrees) +
+                  " degrees) is not in [" + format_number(kMinFovDegrees) + ", " + format_number(kMaxFovDegrees) +
+                  "] degrees, the field of view every camera of tracer's is held to");
     }
     CameraSpec spec;
     spec.eye = world.point(Vec3{0.0f});
@@ -340,8 +343,9 @@ class GltfScene {
     light.position = world.point(Vec3{0.0f});
     light.power = gltf::vec3_of(l.color, Vec3{1.0f}) * float(l.intensity);
     if (!is_finite(light.position) || !is_finite(light.power) || light.power.x < 0.0f || light.power.y < 0.0f ||
-        light.power.z < 0.0f) {
-      throw error("light " + std::to_string(index) + ": position or intensity not finite, or negative");
+        light.power.z < 0.0f || max_component(light.power) > kMaxLightIntensity) {
+      throw error("light " + std::to_string(index) + ": position or intensity not finite, negative or above " +
+                  format_number(kMaxLightIntensity) + " (--light-intensity's limit)");
     }
     scene_.lights.push_back(light);
   }

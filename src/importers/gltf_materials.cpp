@@ -6,6 +6,7 @@
 
 #include "base/text.hpp"
 #include "importers/texture_batch.hpp"
+#include "scene/value_limits.hpp"
 
 namespace tracer::gltf {
 
@@ -48,6 +49,13 @@ Material Materials::map_material(const tg::Material& g, int index) {
   const tg::Value* strength = extension(g.extensions, "KHR_materials_emissive_strength");
   const double emissive_strength = number(strength, "emissiveStrength", 1.0);
   if (g.emissiveFactor.size() >= 3) {
+    const double brightest =
+        std::max({g.emissiveFactor[0], g.emissiveFactor[1], g.emissiveFactor[2]}) * emissive_strength;
+    if (brightest > kMaxEmission) {
+      throw error("material " + in_quotes(mat.name) + ": emission " + format_number(brightest) +
+                  " (emissiveFactor x emissiveStrength) above " + format_number(kMaxEmission) +
+                  ", the limit of emitted radiance in every format (MTL's Ke too)");
+    }
     mat.ke = {float(g.emissiveFactor[0] * emissive_strength), float(g.emissiveFactor[1] * emissive_strength),
               float(g.emissiveFactor[2] * emissive_strength)};
   }
@@ -68,6 +76,7 @@ Material Materials::map_material(const tg::Material& g, int index) {
       !is_finite(specular_colour) || mat.ke.x < 0.0f || mat.ke.y < 0.0f || mat.ke.z < 0.0f) {
     throw error("material " + in_quotes(mat.name) + " has a non-finite or negative extension value");
   }
+
   // The dielectric reflectance at normal incidence: ((ior - 1) / (ior + 1))^2, 0.04 at 1.5.
   const float f0_ior = ior >= 1.0f ? ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f)) : 0.04f;
   const Vec3 f0 = min(specular_colour * f0_ior, Vec3{1.0f}) * std::max(specular_factor, 0.0f);

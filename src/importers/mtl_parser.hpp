@@ -15,6 +15,7 @@
 
 #include "base/errors.hpp"
 #include "math/vec.hpp"
+#include "scene/value_limits.hpp"
 
 namespace tracer {
 
@@ -30,12 +31,6 @@ struct MtlMaterial {
   float bump_multiplier = 1.0f;  // its -bm
   size_t line = 0;               // where `newmtl` stands
 };
-
-// Ranges a value must lie in (the format's, or what the renderer can carry without overflow).
-inline constexpr float kMaxReflectance = 1.0f;  // Ka Kd Ks Tf: fractions of light
-inline constexpr float kMaxEmission = 1e6f;     // Ke: radiance, far above any real lamp's ratio
-inline constexpr float kMaxShininess = 1e6f;    // Ns
-inline constexpr float kMaxIor = 100.0f;        // Ni (0 is accepted: exporters write it for "unset")
 
 // The materials of one file, and its warnings: each one line that names the file and the lines.
 struct MtlFile {

@@ -7,6 +7,7 @@
 #include "base/errors.hpp"
 #include "base/read_input.hpp"
 #include "base/text.hpp"
+#include "scene/value_limits.hpp"
 
 namespace tracer {
 namespace {
@@ -95,8 +96,10 @@ std::vector<View> load_views(const std::string& path) {
     v.camera.eye = parse_field_vec3(f[2], where, "eye");
     v.camera.look = parse_field_vec3(f[3], where, "look");
     v.camera.up = parse_field_vec3(f[4], where, "up");
-    if (!parse_number(f[5], v.camera.fov_degrees) || !(v.camera.fov_degrees > 0.0f) || v.camera.fov_degrees > 179.0f) {
-      throw InputError(where + ": fov: expected degrees in (0, 179], got " + in_quotes(f[5]));
+    if (!parse_number(f[5], v.camera.fov_degrees) || !(v.camera.fov_degrees >= kMinFovDegrees) ||
+        v.camera.fov_degrees > kMaxFovDegrees) {
+      throw InputError(where + ": fov: expected degrees in [" + format_number(kMinFovDegrees) + ", " +
+                       format_number(kMaxFovDegrees) + "], got " + in_quotes(f[5]));
     }
     v.light = parse_field_vec3(f[6], where, "light");
     if (f.size() > 7) v.note = f[7];
