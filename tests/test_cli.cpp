@@ -78,6 +78,14 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --light 1,,3", 2, "--light: expected three numbers"},
       {"render --width 0", 2, "--width: must be between 1 and 16384, got 0"},
       {"render --height 16385", 2, "--height: must be between 1 and 16384, got 16385"},
+      // Memory estimated before it is taken: the film from the flags alone, then scene and build.
+      {"render --width 4096 --height 4096 --max-memory-mib 100", 2,
+       "the image's film (with adaptive sampling's, --noise-threshold): about 608 MiB needed, more than the memory "
+       "limit of 100 MiB (--max-memory-mib"},
+      {"render --builtin-spheres 200000 --max-memory-mib 48 --width 8 --height 8", 1,
+       "builtin:cornell: its 399648 triangles (24 MiB), their accelerator (about 36 MiB) and the image together: about "
+       "60 MiB needed, more than the memory limit of 48 MiB"},
+      {"render --max-memory-mib 0", 2, "--max-memory-mib"},
       {"render --width abc", 2, "--width"},
       {"render --threads 0", 2, "--threads: must be between 1 and 1024, got 0"},
       {"render --threads -3", 2, "--threads"},
@@ -170,6 +178,18 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
     EXPECT_EQ(r.output.rfind("tracer: error: ", 0), 0u) << r.output;
     EXPECT_FALSE(fs::exists(dir_ + "/out.png"));
   }
+  // The film and its layers, from the flags alone, before the scene is read.
+  const test::CommandResult big =
+      test::run_tracer("render --width 16384 --height 16384 --aov albedo,normal,samples --max-memory-mib 16384 -q -o " +
+                       dir_ + "/big.exr");
+  EXPECT_EQ(big.exit_code, 2) << big.output;
+  EXPECT_EQ(big.output.rfind("tracer: error: --width 16384 --height 16384 --aov albedo,normal,samples: the image's "
+                             "film and layers (with adaptive sampling's, --noise-threshold): about 27.50 GiB needed, "
+                             "more than the memory limit of 16.00 GiB",
+                             0),
+            0u)
+      << big.output;
+  EXPECT_FALSE(fs::exists(dir_ + "/big.exr"));
   // No temporary files were left behind either.
   for (const auto& entry : fs::directory_iterator(dir_)) {
     const fs::path ext = entry.path().extension();

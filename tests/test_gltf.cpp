@@ -360,6 +360,64 @@ TEST(Gltf, AbsoluteSchemeAndShellUrisAreRefusedAsSuch) {
   fs::remove_all(root);
 }
 
+// tracer info counts a glTF's nodes once however often they are reached: the counts and bounds
+// of the loaded scene, and 2^40 instances are counted, not placed.
+TEST(Gltf, InfoCountsEachNodeOnceAndAgreesWithTheLoad) {
+  const std::string dir = test::temp_dir();
+  TinyGltf g;
+  g.node = R"({"children": [1, 1, 2]})";
+  g.extra_nodes = R"(, {"mesh": 0, "translation": [2, 0, 0], "children": [2]}, {"mesh": 0, "scale": [1, 3, 1]})";
+  std::ofstream(dir + "/i.gltf") << g.json();
+  const Scene s = load_gltf(dir + "/i.gltf");
+  const auto info = test::run_tracer("info " + dir + "/i.gltf");
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("triangles   " + std::to_string(s.size()) + " (0 degenerate)"), std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("vertices    " + std::to_string(s.vertex_count)), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("geometries  " + std::to_string(s.geometries.size())), std::string::npos) << info.output;
+  char bounds[128];
+  std::snprintf(bounds, sizeof bounds, "bounds      (%g, %g, %g) - (%g, %g, %g)", s.bounds.lo.x, s.bounds.lo.y,
+                s.bounds.lo.z, s.bounds.hi.x, s.bounds.hi.y, s.bounds.hi.z);
+  EXPECT_NE(info.output.find(bounds), std::string::npos) << info.output;
+  // 40 levels each naming the next twice: counted, not expanded (a render refuses it).
+  TinyGltf huge;
+  huge.node = R"({"mesh": 0, "children": [1, 1]})";
+  for (int i = 1; i < 40; ++i)
+    huge.extra_nodes += ", {\"mesh\": 0, \"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
+  huge.extra_nodes += R"(, {"mesh": 0})";
+  std::ofstream(dir + "/huge.gltf") << huge.json();
+  const auto counted = test::run_tracer("info " + dir + "/huge.gltf");
+  EXPECT_EQ(counted.exit_code, 0) << counted.output;
+  EXPECT_NE(counted.output.find("triangles   2199023255551 (0 degenerate)"), std::string::npos) << counted.output;
+  fs::remove_all(dir);
+}
+
+// A glTF whose instances would not fit the memory limit is refused before they are expanded.
+TEST(Gltf, InstancesAboveTheMemoryLimitAreRefusedBeforeExpanding) {
+  TinyGltf g;  // 2^20 instances of a triangle: 144 bytes each with the accelerator, 72 a geometry
+  g.node = R"({"children": [1, 1]})";
+  for (int i = 1; i < 20; ++i)
+    g.extra_nodes += ", {\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
+  g.extra_nodes += R"(, {"mesh": 0})";
+  LoadLimits limits;
+  limits.max_memory = uint64_t(64) << 20;
+  limits.accel_bytes_per_triangle = 96;
+  std::string e;
+  try {
+    load_gltf_from_memory(
+        g.json(), "t.gltf", [](const std::string&) {}, limits);
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  EXPECT_EQ(
+      e.rfind("t.gltf: the 1048576 triangles its instances expand to and their accelerator: about 216 MiB needed", 0),
+      0u)
+      << e;
+  EXPECT_NE(e.find("needed, more than the memory limit of 64 MiB (--max-memory-mib"), std::string::npos) << e;
+  limits.max_memory = uint64_t(1) << 30;
+  EXPECT_EQ(load_gltf_from_memory(g.json(), "t.gltf", {}, limits).size(), 1u << 20);
+}
+
 TEST(Gltf, ExternalFilesMustLieInsideTheScenesFolder) {
   const std::string root = test::temp_dir();
   fs::create_directories(root + "/scene/textures");

@@ -45,6 +45,26 @@ inline constexpr float kHighSplitBudget = 0.2f;
 // Whether `kind` builds at a quality level: the 8-wide BVH and Embree.
 inline bool has_build_quality(AccelKind kind) { return kind == AccelKind::Bvh8 || is_embree(kind); }
 
+// The most a build of `kind` holds per triangle at its peak (the tree, its triangle packs and the
+// builder's references), above the scene's own arrays: measured on a 4M-triangle mesh as the
+// peak resident set of a render less a load's (docs/RELIABILITY.md, "Memory"), rounded up.
+inline uint64_t build_bytes_per_triangle(AccelKind kind, BuildQuality quality) {
+  switch (kind) {
+    case AccelKind::Brute:
+    case AccelKind::BruteSimd:
+      return 16;
+    case AccelKind::Bvh:
+      return 144;
+    case AccelKind::Bvh8:
+      return quality == BuildQuality::High ? 104 : 96;
+    case AccelKind::Embree:
+      return quality == BuildQuality::High ? 128 : 120;
+    case AccelKind::EmbreeHigh:
+      return 128;
+  }
+  return 144;
+}
+
 struct AccelOptions {
   AccelKind kind = AccelKind::Bvh8;             // the fastest (docs/BENCHMARKS.md section 1)
   BuildQuality quality = BuildQuality::Medium;  // Bvh8 and Embree; EmbreeHigh is always High

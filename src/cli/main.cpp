@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cinttypes>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -93,17 +94,20 @@ int cmd_render(const RenderArgs& args) {
 }
 
 int cmd_info(const SceneArgs& args) {
-  const Scene scene = load_scene(args, /*quiet=*/false);
+  const SceneInfo scene = scene_info(args, /*quiet=*/false);
   std::printf("scene       %s\n", scene.source.c_str());
-  std::printf("triangles   %zu (%zu degenerate)\n", scene.size(), scene.degenerate_count);
-  std::printf("vertices    %zu\n", scene.vertex_count);
-  std::printf("geometries  %zu\n", scene.geometries.size());
+  std::printf("triangles   %" PRIu64 " (%" PRIu64 " degenerate)\n", scene.triangles, scene.degenerate);
+  std::printf("vertices    %" PRIu64 "\n", scene.vertices);
+  std::printf("geometries  %" PRIu64 "\n", scene.geometries);
   std::printf("materials   %zu:", scene.materials.size());
-  for (const Material& m : scene.materials) std::printf(" %s", m.name.c_str());
-  std::printf("\nlights      %zu\n", scene.lights.size());
+  for (const std::string& m : scene.materials) std::printf(" %s", m.c_str());
+  std::printf("\nlights      %" PRIu64 "\n", uint64_t(scene.lights.size()) + scene.unlisted_area_lights);
   for (const Light& l : scene.lights) {
     std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x,
                 l.position.y, l.position.z, l.power.x, l.power.y, l.power.z);
+  }
+  if (scene.unlisted_area_lights) {
+    std::printf("  area: %" PRIu64 " emissive primitives placed by the node tree\n", scene.unlisted_area_lights);
   }
   if (!scene.cameras.empty()) {
     std::printf("cameras     %zu (--camera N)\n", scene.cameras.size());

@@ -73,6 +73,10 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
                      "memory all the scene's textures may take, in MiB (1-1048576); past it a texture is not used"),
       1, 1 << 20)
       ->capture_default_str();
+  whole_option(app.add_option("--max-memory-mib", a.max_memory_mib,
+                              "memory the scene, its accelerator and the image may take, in MiB (1-1073741824; "
+                              "default: the memory available less a tenth); a render estimated above it is refused"),
+               1, 1 << 30);
 }
 
 void add_render_options(CLI::App& app, RenderArgs& a) {

@@ -33,6 +33,7 @@ struct SceneArgs {
   std::optional<int> camera;  // --camera: which of a glTF's cameras (default its first)
   long long max_input_mib = kDefaultMaxInputBytes >> 20;              // --max-input-mib: the scene file
   long long max_texture_mib = TextureLimits{}.max_total_bytes >> 20;  // --max-texture-mib: all textures
+  std::optional<long long> max_memory_mib;  // --max-memory-mib: empty, the available memory less a margin
 };
 
 // The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,

@@ -6,8 +6,10 @@
 #include <iostream>
 
 #include "base/errors.hpp"
+#include "driver/memory_estimate.hpp"
 #include "driver/output_checks.hpp"
 #include "driver/parse.hpp"
+#include "importers/gltf_loader.hpp"
 #include "importers/scene_file.hpp"
 #include "io/environment_io.hpp"
 #include "parallel/executor.hpp"
@@ -58,10 +60,13 @@ void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel, const 
 
 }  // namespace
 
-Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* phases) {
+Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* phases, const MemoryBudget& memory) {
   check_range("--max-input-mib", a.max_input_mib, 1, 1 << 20);
   check_range("--max-texture-mib", a.max_texture_mib, 1, 1 << 20);
+  if (a.max_memory_mib) check_range("--max-memory-mib", *a.max_memory_mib, 1, 1ll << 30);
   LoadLimits limits;
+  limits.max_memory = memory.bytes ? memory.bytes : memory_limit(a);
+  limits.accel_bytes_per_triangle = memory.accel_bytes_per_triangle;
   limits.max_obj_bytes = uint64_t(a.max_input_mib) << 20;
   limits.textures.max_total_bytes = uint64_t(a.max_texture_mib) << 20;
   // Textures are read and decoded on every thread the render may use.
@@ -157,6 +162,18 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
   if (a.focus_distance) spec.focus_distance = float(*a.focus_distance);
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
   return spec;
+}
+
+SceneInfo scene_info(const SceneArgs& a, bool quiet) {
+  // A glTF as the file says (nothing added by flags) is counted without placing its instances.
+  const bool as_file = a.view.empty() && a.lights.empty() && !a.no_scene_lights && !a.light_intensity &&
+                       a.env_map.empty() && !a.camera && !a.scene.empty() && a.scene != "-";
+  if (!as_file || scene_format(a.scene) != SceneFormat::Gltf) return info_of(load_scene(a, quiet));
+  check_range("--max-input-mib", a.max_input_mib, 1, 1 << 20);
+  LoadLimits limits;
+  limits.max_obj_bytes = uint64_t(a.max_input_mib) << 20;
+  const WarningSink silent = [](const std::string&) {};
+  return gltf_info(a.scene, quiet ? silent : WarningSink{}, nullptr, limits);
 }
 
 }  // namespace tracer::driver

@@ -9,12 +9,14 @@
 #include <optional>
 #include <set>
 
+#include "base/memory_limit.hpp"
 #include "base/read_input.hpp"
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
 #include "importers/gltf_document.hpp"
 #include "importers/gltf_materials.hpp"
 #include "importers/indexed_mesh.hpp"
+#include "scene/scene_info.hpp"
 #include "scene/value_limits.hpp"
 
 namespace tracer {
@@ -47,41 +49,78 @@ class GltfScene {
   Scene build() {
     scene_.source = name_;
     warn_unsupported();
-    const int chosen = choose_scene();
-    std::vector<int> roots;
-    if (chosen >= 0) {
-      roots = model_.scenes[size_t(chosen)].nodes;
-    } else {  // no scenes: every node no other node names as a child
-      std::vector<char> is_child(model_.nodes.size(), 0);
-      for (const tg::Node& n : model_.nodes)
-        for (int c : n.children)
-          if (c >= 0 && size_t(c) < is_child.size()) is_child[size_t(c)] = 1;
-      for (size_t i = 0; i < model_.nodes.size(); ++i)
-        if (!is_child[i]) roots.push_back(int(i));
-    }
-    // The instances' triangles counted first, so that a tree that would expand past the limit
-    // fails before anything is allocated.
+    const std::vector<int> roots = root_nodes();
+    // The instances' triangles counted first (once per node: a subtree counts the same wherever
+    // it is reached), so that a tree that would not fit fails before anything is allocated.
     std::vector<uint64_t> subtree(model_.nodes.size(), kUncounted);
-    uint64_t total = 0;
-    for (int root : roots) total = std::min(total + count_triangles(root, subtree, 0), kMaxTriangles + 1);
+    std::vector<Placed> placed(model_.nodes.size());
+    Placed all;
+    for (int root : roots) all.add(count_placed(root, subtree, placed, 0));
+    const uint64_t total = all.triangles;
+    const bool normals = any_attribute("NORMAL"), uvs = any_attribute("TEXCOORD_0");
+    const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits_.accel_bytes_per_triangle;
+    constexpr uint64_t kPerPrimitive = sizeof(Geometry) + 32;  // and its name
+    const uint64_t estimate = total >= kSaturated / per_triangle || all.primitives >= kSaturated / kPerPrimitive
+                                  ? UINT64_MAX
+                                  : total * per_triangle + all.primitives * kPerPrimitive;
+    if (estimate > limits_.max_memory) {
+      throw InputError(memory_refusal(where("the " + (total >= kSaturated ? "more than 2^62" : std::to_string(total)) +
+                                            " triangles its instances expand to" +
+                                            (limits_.accel_bytes_per_triangle ? " and their accelerator" : "")),
+                                      estimate, limits_.max_memory));
+    }
     if (total > kMaxTriangles) {
       throw error("its instances expand to more than " + std::to_string(kMaxTriangles) +
                   " triangles, more than tracer loads");
     }
+    // Reserved once: grown by doubling, the arrays would take up to twice the estimate.
+    scene_.triangles.reserve(total);
+    scene_.tri_geom.reserve(total);
+    scene_.tri_prim.reserve(total);
+    scene_.tri_material.reserve(total);
+    if (normals) scene_.corner_normals.reserve(3 * total);
+    if (uvs) scene_.corner_uvs.reserve(3 * total);
+    scene_.geometries.reserve(all.primitives);
     std::vector<char> on_path(model_.nodes.size(), 0);
     for (int root : roots) visit(root, Affine{}, on_path, 0);
     if (scene_.triangles.empty()) throw InputError(name_ + ": scene has no triangles");
     materials_.attach_textures(scene_);
     scene_.finalize();
-    // A glTF camera has no point it looks at: the look-at point (where the lens focuses by
-    // default) is taken level with the scene's centre along the view.
-    for (CameraSpec& c : scene_.cameras) {
-      const Vec3 forward = c.look - c.eye;
-      const float d = dot(scene_.bounds.center() - c.eye, forward);
-      if (d > 0.0f && std::isfinite(d)) c.look = c.eye + forward * d;
-    }
+    look_at_centre();
     if (!scene_.cameras.empty()) scene_.camera = scene_.cameras.front();
     return std::move(scene_);
+  }
+
+  // What tracer info prints, each node counted once however often it is reached: counts and
+  // bounds from per-node sums (the bounds are those of the instances' boxes), and the world
+  // transform walked only down to the cameras and point lights that are listed.
+  SceneInfo summarize() {
+    warn_unsupported();
+    const std::vector<int> roots = root_nodes();
+    std::vector<uint64_t> state(model_.nodes.size(), kUncounted);
+    std::vector<Summary> sums(model_.nodes.size());
+    Summary all;
+    for (int root : roots) all.add(summarize_node(root, state, sums, 0), Affine{});
+    SceneInfo info;
+    info.source = name_;
+    info.triangles = all.placed.triangles;
+    info.geometries = all.placed.primitives;
+    info.vertices = all.vertices;
+    info.degenerate = all.degenerate;
+    info.unlisted_area_lights = all.emissive;
+    info.bounds = all.box;
+    if (all.placed.primitives > 0 && uses_default_material()) info.materials.push_back(Material{}.name);
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+      info.materials.push_back(model_.materials[i].name.empty() ? "material " + std::to_string(i)
+                                                                : model_.materials[i].name);
+    }
+    std::vector<char> on_path(model_.nodes.size(), 0);
+    for (int root : roots) visit_listed(root, Affine{}, sums, on_path, 0);
+    info.lights = scene_.lights;
+    scene_.bounds = info.bounds;
+    look_at_centre();
+    info.cameras = scene_.cameras;
+    return info;
   }
 
  private:
@@ -114,6 +153,125 @@ class GltfScene {
     return chosen;
   }
 
+  // What node `index` and its descendants place: triangles and primitives (each a geometry of
+  // the scene). Memoised, saturating at kSaturated.
+  struct Placed {
+    uint64_t triangles = 0, primitives = 0;
+    void add(const Placed& o) {
+      triangles = std::min(triangles + o.triangles, kSaturated);
+      primitives = std::min(primitives + o.primitives, kSaturated);
+    }
+  };
+  bool uses_default_material() const {
+    for (const tg::Mesh& m : model_.meshes)
+      for (const tg::Primitive& p : m.primitives)
+        if (p.material < 0) return true;
+    return false;
+  }
+
+  // The chosen scene's root nodes; with no scenes, every node no other node names as a child.
+  std::vector<int> root_nodes() {
+    const int chosen = choose_scene();
+    if (chosen >= 0) return model_.scenes[size_t(chosen)].nodes;
+    std::vector<int> roots;
+    std::vector<char> is_child(model_.nodes.size(), 0);
+    for (const tg::Node& n : model_.nodes)
+      for (int c : n.children)
+        if (c >= 0 && size_t(c) < is_child.size()) is_child[size_t(c)] = 1;
+    for (size_t i = 0; i < model_.nodes.size(); ++i)
+      if (!is_child[i]) roots.push_back(int(i));
+    return roots;
+  }
+
+  // A subtree's sums for tracer info, in the frame of its node's parent.
+  struct Summary {
+    Placed placed;
+    uint64_t vertices = 0, degenerate = 0, emissive = 0;
+    Aabb box;
+    bool listed = false;  // holds a camera or a point light
+    void add(const Summary& o, const Affine& to) {
+      placed.add(o.placed);
+      vertices = std::min(vertices + o.vertices, kSaturated);
+      degenerate = std::min(degenerate + o.degenerate, kSaturated);
+      emissive = std::min(emissive + o.emissive, kSaturated);
+      if (!o.box.empty()) {
+        for (int c = 0; c < 8; ++c) {
+          box.extend(to.point(
+              Vec3{c & 1 ? o.box.hi.x : o.box.lo.x, c & 2 ? o.box.hi.y : o.box.lo.y, c & 4 ? o.box.hi.z : o.box.lo.z}));
+        }
+      }
+      listed = listed || o.listed;
+    }
+  };
+
+  Summary summarize_node(int index, std::vector<uint64_t>& state, std::vector<Summary>& sums, int depth) {
+    throw_if_cancelled(cancel_);
+    check_node(index, depth);
+    uint64_t& s = state[size_t(index)];
+    if (s == kCounting) throw error("node " + std::to_string(index) + " is its own ancestor");
+    if (s != kUncounted) return sums[size_t(index)];
+    s = kCounting;
+    const tg::Node& node = model_.nodes[size_t(index)];
+    Summary here;  // in the node's own frame first
+    if (node.mesh >= 0) {
+      if (size_t(node.mesh) >= model_.meshes.size()) {
+        throw error("mesh " + std::to_string(node.mesh) + " does not exist (the file has " +
+                    std::to_string(model_.meshes.size()) + ")");
+      }
+      const tg::Mesh& m = model_.meshes[size_t(node.mesh)];
+      for (size_t k = 0; k < m.primitives.size(); ++k) {
+        auto [it, fresh] = meshes_.try_emplace({node.mesh, int(k)});
+        if (fresh) it->second = primitive_mesh(m.primitives[k], primitive_name(node.mesh, k));
+        if (!it->second) continue;
+        const IndexedMesh& mesh = *it->second;
+        ++here.placed.primitives;
+        here.placed.triangles += mesh.triangle_count();
+        here.vertices += mesh.positions.size();
+        for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+          const uint32_t* ix = &mesh.indices[3 * t];
+          if (Triangle{mesh.positions[ix[0]], mesh.positions[ix[1]], mesh.positions[ix[2]]}.degenerate())
+            ++here.degenerate;
+        }
+        for (const Vec3& v : mesh.positions) here.box.extend(v);
+        const int material = m.primitives[k].material;
+        if (material >= 0 && size_t(material) < model_.materials.size()) {
+          const std::vector<double>& e = model_.materials[size_t(material)].emissiveFactor;
+          if (e.size() >= 3 && (e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0)) ++here.emissive;
+        }
+      }
+    }
+    here.listed = node.camera >= 0 || gltf::extension(node.extensions, "KHR_lights_punctual");
+    for (int child : node.children) {
+      here.add(summarize_node(child, state, sums, depth + 1), local_transform(model_.nodes[size_t(child)]));
+    }
+    s = 0;
+    sums[size_t(index)] = here;
+    return here;
+  }
+
+  // The cameras and point lights below `index`, placed; subtrees without any are not entered.
+  void visit_listed(int index, const Affine& parent, const std::vector<Summary>& sums, std::vector<char>& on_path,
+                    int depth) {
+    throw_if_cancelled(cancel_);
+    if (!sums[size_t(index)].listed) return;
+    const tg::Node& node = model_.nodes[size_t(index)];
+    const Affine world = parent * local_transform(node);
+    if (!world.finite()) throw error("node " + std::to_string(index) + " has a transform that is not finite");
+    if (node.camera >= 0) add_camera(node.camera, world);
+    if (const tg::Value* light = gltf::extension(node.extensions, "KHR_lights_punctual")) add_light(*light, world);
+    for (int child : node.children) visit_listed(child, world, sums, on_path, depth + 1);
+  }
+
+  // A glTF camera has no point it looks at: the look-at point (where the lens focuses by
+  // default) is taken level with the scene's centre along the view.
+  void look_at_centre() {
+    for (CameraSpec& c : scene_.cameras) {
+      const Vec3 forward = c.look - c.eye;
+      const float d = dot(scene_.bounds.center() - c.eye, forward);
+      if (d > 0.0f && std::isfinite(d)) c.look = c.eye + forward * d;
+    }
+  }
+
   static Affine local_transform(const tg::Node& n) {
     if (n.matrix.size() == 16) return Affine::from_column_major(n.matrix.data());
     const double t[3] = {n.translation.size() == 3 ? n.translation[0] : 0.0,
@@ -132,6 +290,15 @@ class GltfScene {
   }
 
   static constexpr uint64_t kUncounted = ~uint64_t(0), kCounting = ~uint64_t(0) - 1;
+  static constexpr uint64_t kSaturated = uint64_t(1) << 62;  // counts stop growing here
+
+  // Whether any primitive has the attribute (the scene then keeps it for every triangle).
+  bool any_attribute(const char* name) const {
+    for (const tg::Mesh& m : model_.meshes)
+      for (const tg::Primitive& p : m.primitives)
+        if (p.attributes.count(name)) return true;
+    return false;
+  }
 
   void check_node(int index, int depth) const {
     if (index < 0 || size_t(index) >= model_.nodes.size()) {
@@ -160,18 +327,22 @@ class GltfScene {
     return n;
   }
 
-  // The triangles node `index` and its descendants place (memoised; saturating past the limit).
-  uint64_t count_triangles(int index, std::vector<uint64_t>& subtree, int depth) const {
+  Placed count_placed(int index, std::vector<uint64_t>& subtree, std::vector<Placed>& placed, int depth) const {
     check_node(index, depth);
-    uint64_t& n = subtree[size_t(index)];
-    if (n == kCounting) throw error("node " + std::to_string(index) + " is its own ancestor");
-    if (n != kUncounted) return n;
-    n = kCounting;
+    uint64_t& state = subtree[size_t(index)];
+    if (state == kCounting) throw error("node " + std::to_string(index) + " is its own ancestor");
+    if (state != kUncounted) return placed[size_t(index)];
+    state = kCounting;
     const tg::Node& node = model_.nodes[size_t(index)];
-    uint64_t sum = std::min(mesh_triangles(node.mesh), kMaxTriangles + 1);
-    for (int child : node.children) sum = std::min(sum + count_triangles(child, subtree, depth + 1), kMaxTriangles + 1);
-    n = sum;
-    return n;
+    Placed sum;
+    if (node.mesh >= 0 && size_t(node.mesh) < model_.meshes.size()) {
+      sum.triangles = mesh_triangles(node.mesh);
+      sum.primitives = model_.meshes[size_t(node.mesh)].primitives.size();
+    }
+    for (int child : node.children) sum.add(count_placed(child, subtree, placed, depth + 1));
+    state = 0;
+    placed[size_t(index)] = sum;
+    return sum;
   }
 
   void visit(int index, const Affine& parent, std::vector<char>& on_path, int depth) {
@@ -376,6 +547,19 @@ Scene load(std::string_view bytes, const std::string& name, const fs::path& base
 }
 
 }  // namespace
+
+SceneInfo gltf_info(const std::string& path, const WarningSink& warn_in, CancelFlag cancel, const LoadLimits& limits) {
+  const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
+  const InputBytes bytes = map_input(path, cancel, limits.max_obj_bytes);
+  const fs::path dir = fs::path(path).parent_path();
+  WarningLog warnings;
+  const tg::Model model = gltf::parse(bytes.view(), path, dir.empty() ? fs::path(".") : dir, limits, cancel, warnings);
+  LoadLimits geometry_only = limits;
+  geometry_only.read_textures = false;
+  SceneInfo info = GltfScene(model, path, dir, geometry_only, cancel, warnings).summarize();
+  warnings.flush(path, warn);
+  return info;
+}
 
 Scene load_gltf(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits,
                 LoadPhases* phases) {

@@ -25,6 +25,11 @@ struct LoadLimits {
   ForEach for_each = sequential_for_each;
   size_t chunk_bytes = 0;     // the OBJ parser's chunk size; 0: from the file's size
   bool read_textures = true;  // false: no map_Kd file is read, materials use Kd (geometry-only loads)
+  // What the scene and the accelerator built over it may take. A loader that knows a scene's size
+  // before allocating it (glTF's instances, counted before they are expanded) refuses one whose
+  // estimate, its arrays plus accel_bytes_per_triangle for each triangle, is above max_memory.
+  uint64_t max_memory = UINT64_MAX;
+  uint64_t accel_bytes_per_triangle = 0;  // 0: no accelerator follows (tracer info)
 };
 
 // Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its

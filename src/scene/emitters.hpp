@@ -35,6 +35,7 @@ class Emitters {
   // The solid-angle density with which sample() picks the point `to` on scene triangle `tri`
   // from `from`: 0 when `tri` is not one of the emitters.
   float pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const;
+  uint64_t memory_bytes() const { return tris_.capacity() * 4 * sizeof(float); }
 
  private:
   std::vector<uint32_t> tris_;  // scene triangle indices, ascending

@@ -79,4 +79,13 @@ void Scene::finalize() {
   emitters = Emitters(*this);
 }
 
+uint64_t Scene::memory_bytes() const {
+  uint64_t bytes = triangles.capacity() * sizeof(Triangle) +
+                   (tri_geom.capacity() + tri_prim.capacity() + tri_material.capacity()) * sizeof(uint32_t) +
+                   corner_normals.capacity() * sizeof(Vec3) + corner_uvs.capacity() * sizeof(Vec2) +
+                   geometries.capacity() * sizeof(Geometry) + emitters.memory_bytes();
+  for (const Texture& t : textures) bytes += t.srgb().size() * 4 / 3;  // and its mip levels
+  return bytes;
+}
+
 }  // namespace tracer

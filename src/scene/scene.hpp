@@ -130,6 +130,13 @@ struct Scene {
   // Appends a geometry from an indexed mesh; material is an index into `materials`.
   void add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
                 uint32_t material);
+  // The bytes its arrays and textures hold (an estimate of what it occupies).
+  uint64_t memory_bytes() const;
+  // Per triangle: its corners, ids and material, and its corners' normals and texture coordinates
+  // where the scene has them.
+  static constexpr uint64_t bytes_per_triangle(bool normals, bool uvs) {
+    return sizeof(Triangle) + 3 * sizeof(uint32_t) + (normals ? 3 * sizeof(Vec3) : 0) + (uvs ? 3 * sizeof(Vec2) : 0);
+  }
   // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials.
   void finalize();
 };

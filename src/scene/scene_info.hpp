@@ -1,0 +1,38 @@
+// What `tracer info` tells of a scene: its counts, materials, lights, cameras and bounds. Made
+// from a loaded Scene, or by a loader that can count without placing every triangle (a glTF's
+// instances: each node counted once, however often it is reached).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace tracer {
+
+struct SceneInfo {
+  std::string source;
+  uint64_t triangles = 0, degenerate = 0, vertices = 0, geometries = 0;
+  std::vector<std::string> materials;
+  std::vector<Light> lights;          // every light listed
+  uint64_t unlisted_area_lights = 0;  // emissive geometries counted but not placed (a glTF's)
+  std::vector<CameraSpec> cameras;
+  Aabb bounds;
+};
+
+inline SceneInfo info_of(const Scene& scene) {
+  SceneInfo info;
+  info.source = scene.source;
+  info.triangles = scene.size();
+  info.degenerate = scene.degenerate_count;
+  info.vertices = scene.vertex_count;
+  info.geometries = scene.geometries.size();
+  for (const Material& m : scene.materials) info.materials.push_back(m.name);
+  info.lights = scene.lights;
+  info.cameras = scene.cameras;
+  info.bounds = scene.bounds;
+  return info;
+}
+
+}  // namespace tracer
