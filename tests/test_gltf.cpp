@@ -677,6 +677,13 @@ TEST(Ply, HostileFilesFailWithOneLineNamingTheFileAndLine) {
       {ascii + "property float x\n", "t.ply:3: a property before any element"},
       {ascii + "element vertex 1\nproperty quad x\nend_header\n", "t.ply:4: unknown property type 'quad'"},
       {ascii + "element vertex 1\nproperty float y\nend_header\n0\n", "t.ply:3: vertex has no x, y and z"},
+      {ascii + vertex + face + "end_header\n0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "t.ply:10: more values than element 'vertex' declares properties ('7' is one too many)"},
+      {ascii + vertex + face + "end_header\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+       "t.ply:11: the line ends inside a row (fewer values than its element's properties)"},
+      {ascii + "element vertex 1\nproperty float x\nproperty float x\n",
+       "t.ply:5: property 'x' declared twice in element 'vertex'"},
+      {"", "t.ply: an empty file, not a PLY file"},
   };
   for (const Case& c : cases) {
     const std::string e = ply_error(c.text);

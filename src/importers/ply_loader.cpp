@@ -90,6 +90,7 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
   const auto fail = [&](const std::string& what) -> InputError {
     return InputError(name + ":" + std::to_string(line_no) + ": " + what);
   };
+  if (bytes.empty()) throw InputError(name + ": an empty file, not a PLY file");
   while (true) {
     if (pos >= bytes.size()) throw fail("the header has no end_header line");
     const size_t end = std::min(bytes.find('\n', pos), bytes.size());
@@ -140,6 +141,10 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
       } else {
         throw fail("expected 'property <type> <name>' or 'property list <type> <type> <name>'");
       }
+      if (h.elements.back().find(prop.name) >= 0) {
+        throw fail("property " + in_quotes(prop.name) + " declared twice in element " +
+                   in_quotes(h.elements.back().name));
+      }
       h.elements.back().properties.push_back(std::move(prop));
     } else {  // a line tracer cannot place might declare data: the rows would be misread
       throw fail("unknown header line " + in_quotes(t[0]));
@@ -189,6 +194,30 @@ class BodyReader {
     return 0.0;
   }
 
+  // Before a row: blank lines are passed over (ASCII).
+  void begin_row() {
+    if (!ascii()) return;
+    while (pos_ < bytes_.size() &&
+           (bytes_[pos_] == ' ' || bytes_[pos_] == '\t' || bytes_[pos_] == '\r' || bytes_[pos_] == '\n')) {
+      if (bytes_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+  }
+  // After a row: its line ends here (ASCII).
+  void end_row(const std::string& element) {
+    if (!ascii()) return;
+    skip_blanks();
+    if (pos_ < bytes_.size() && bytes_[pos_] != '\n') {
+      throw fail("more values than element " + in_quotes(element) + " declares properties (" +
+                 in_quotes(bytes_.substr(pos_, std::min<size_t>(20, bytes_.find_first_of("\r\n", pos_) - pos_))) +
+                 " is one too many)");
+    }
+    if (pos_ < bytes_.size()) {
+      ++pos_;
+      ++line_;
+    }
+  }
+
   InputError fail(const std::string& what) const {
     return InputError(ascii() ? name_ + ":" + std::to_string(line_) + ": " + what : name_ + ": " + what);
   }
@@ -201,11 +230,17 @@ class BodyReader {
     return v;
   }
 
+  // The values of a row stand on one line: a value is read within the line, and end_row() checks
+  // that the line holds no more, so that a row with an extra value is named at its line instead of
+  // shifting every row after it.
+  void skip_blanks() {
+    while (pos_ < bytes_.size() && (bytes_[pos_] == ' ' || bytes_[pos_] == '\t' || bytes_[pos_] == '\r')) ++pos_;
+  }
+
   double ascii_value(PlyType type, const char* what) {
-    while (pos_ < bytes_.size() &&
-           (bytes_[pos_] == ' ' || bytes_[pos_] == '\t' || bytes_[pos_] == '\r' || bytes_[pos_] == '\n')) {
-      if (bytes_[pos_] == '\n') ++line_;
-      ++pos_;
+    skip_blanks();
+    if (pos_ < bytes_.size() && bytes_[pos_] == '\n') {
+      throw fail(std::string("the line ends inside ") + what + " (fewer values than its element's properties)");
     }
     const size_t start = pos_;
     while (pos_ < bytes_.size() && bytes_[pos_] != ' ' && bytes_[pos_] != '\t' && bytes_[pos_] != '\r' &&
@@ -301,6 +336,7 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
     row.resize(e.properties.size());
     for (uint64_t r = 0; r < e.count; ++r) {
       if ((r & 0xffff) == 0) throw_if_cancelled(cancel);
+      in.begin_row();
       for (size_t k = 0; k < e.properties.size(); ++k) {
         const PlyProperty& p = e.properties[k];
         if (!p.list) {
@@ -351,6 +387,7 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
             for (uint32_t c : t) mesh.indices.push_back(polygon[c]);
         }
       }
+      in.end_row(e.name);
     }
   }
   if (in.remaining() > 0 && !in.ascii()) warnings.add("bytes after the last element ignored");
