@@ -33,18 +33,14 @@ std::string names_of(std::span<const EnumName<E>> table) {
   return out;
 }
 
-// The value named `text` (case-insensitive), or a UsageError "FLAG: unknown WHAT 'text' (names)".
+// The value named exactly `text` (names are lower case, and every flag reads them alike: "HIGH"
+// is no more a quality than "PATH" an integrator), or a UsageError "FLAG: unknown WHAT 'text'
+// (names)".
 template <class E>
 E parse_name(std::span<const EnumName<E>> table, std::string_view text, const std::string& flag,
              const std::string& what) {
   for (const EnumName<E>& e : table) {
-    if (e.name.size() != text.size()) continue;
-    bool same = true;
-    for (size_t i = 0; i < text.size() && same; ++i) {
-      const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? char(c - 'A' + 'a') : c; };
-      same = lower(text[i]) == e.name[i];
-    }
-    if (same) return e.value;
+    if (e.name == text) return e.value;
   }
   throw UsageError(flag + ": unknown " + what + " '" + std::string(text) + "' (" + names_of(table) + ")");
 }

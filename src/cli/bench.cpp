@@ -46,6 +46,10 @@ void add_bench_options(CLI::App& app, BenchArgs& a) {
   app.add_option("--runs", a.runs, "timed runs per cell")->capture_default_str();
   app.add_option("--best", a.best, "mean of the best k runs (the study's k-best rule)")->capture_default_str();
   app.add_option("--threads", a.threads, "threads for the parallel variants (default: all)");
+  app.add_option("--build-quality", a.build_quality,
+                 "build the variants that have quality levels and none in their name (bvh8, best, embree, "
+                 "embree-packets) at this one: " +
+                     names_of<BuildQuality>(kBuildQualityNames) + " (their names then say it)");
   app.add_option("--max-seconds", a.max_seconds,
                  "time cap per cell, all its runs together: later runs are skipped, a run at the cap is stopped")
       ->capture_default_str();
@@ -71,7 +75,16 @@ int run_bench(const BenchArgs& a) {
   const int threads = a.threads.value_or(0);
   const ThreadLimit thread_limit(threads);
   check_range_real("--max-seconds", a.max_seconds, 0.0, 1e7, LowEnd::Open);
-  const std::vector<Variant> variants = resolve_variants(a.variants);
+  std::vector<Variant> variants = resolve_variants(a.variants);
+  if (a.build_quality) {
+    const BuildQuality q = parse_name<BuildQuality>(kBuildQualityNames, *a.build_quality, "--build-quality", "quality");
+    for (Variant& v : variants) {
+      if (!has_build_quality(v.accel) || v.accel == AccelKind::EmbreeHigh || v.quality == q) continue;
+      if (v.name.find("-high") != std::string::npos) continue;  // a quality of its own
+      v.quality = q;
+      v.name += "@" + std::string(name_of<BuildQuality>(kBuildQualityNames, q));
+    }
+  }
   const std::vector<SceneEntry> scenes = resolve_scenes(a);
   const std::pair<const std::string*, const char*> outputs[] = {
       {&a.json, "--json"}, {&a.plot, "--plot"}, {&a.markdown, "--markdown"}};

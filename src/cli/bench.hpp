@@ -22,8 +22,9 @@ struct BenchArgs {
   std::string integrator{name_of<Integrator>(kIntegratorNames, Integrator::Ao)};  // the study's workload
   int spp = 16;                                                                   // path: samples per pixel
   int runs = 10, best = 3;
-  std::optional<int> threads;  // empty: all hardware threads
-  double max_seconds = 10.0;   // per cell, all runs together
+  std::optional<int> threads;                // empty: all hardware threads
+  std::optional<std::string> build_quality;  // the quality of the variants that build at the default one
+  double max_seconds = 10.0;                 // per cell, all runs together
   std::string json, plot, markdown;
   bool list = false;
 };

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "base/errors.hpp"
+#include "base/text.hpp"
 #include "driver/memory_estimate.hpp"
 #include "driver/output_checks.hpp"
 #include "driver/parse.hpp"
@@ -159,7 +160,16 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
   }
   if (length(forward) == 0.0f) throw UsageError("--eye/--look: the camera looks at its own position");
   if (a.aperture) spec.lens_radius = float(*a.aperture);
-  if (a.focus_distance) spec.focus_distance = float(*a.focus_distance);
+  if (a.focus_distance) {
+    // Nearer than this, a lens focuses on nothing of the scene: every ray leaves sideways.
+    const double diagonal = length(scene.bounds.extent());
+    if (*a.focus_distance < 1e-6 * diagonal) {
+      throw UsageError("--focus-distance " + format_number(*a.focus_distance) +
+                       ": below a millionth of the scene's size (its diagonal, " + format_number(diagonal) +
+                       "): a lens focused there shows nothing of the scene");
+    }
+    spec.focus_distance = float(*a.focus_distance);
+  }
   if (length(cross(forward, spec.up)) == 0.0f) throw UsageError("--up: parallel to the viewing direction");
   return spec;
 }
