@@ -213,6 +213,23 @@ TEST_F(Cli, StatsJsonDashIsStandardOutput) {
   EXPECT_FALSE(fs::exists("-"));
 }
 
+// A scene with no light of its own is path-traced under a white sky that the statistics name as
+// tracer's, not the file's; --env 0,0,0 keeps it black; the built-in box's lamp is its own.
+TEST_F(Cli, TheDefaultSkyIsNamedInTheStatistics) {
+  const auto lighting = [&](const std::string& flags) {
+    // In braces: run_shell's 2>&1 applies to the group, and the note stays out of the JSON.
+    const test::CommandResult r =
+        test::run_shell("{ " + std::string(TRACER_EXE) + " render -q --width 8 --height 8 --spp 2 -o " + dir_ +
+                        "/o.png --stats-json - " + flags + " 2>/dev/null; }");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return nlohmann::json::parse(r.output)["lighting"].get<std::string>();
+  };
+  EXPECT_EQ(lighting(dir_ + "/ok.obj"),
+            "a uniform sky (1, 1, 1) added by tracer: the scene has no emissive surface (--env 0,0,0 for none)");
+  EXPECT_EQ(lighting(dir_ + "/ok.obj --env 0,0,0"), "none");
+  EXPECT_EQ(lighting(""), "2 emissive triangles");
+}
+
 // Two outputs of one bench that are one file, and an output that is an MTL file of a scene: both
 // refused before any cell runs (no table printed).
 TEST_F(Cli, BenchOutputsAreRefusedBeforeTheBenchmarkRuns) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "base/text.hpp"
 #include "io/image_io.hpp"
 
 namespace tracer::driver {
@@ -16,6 +17,32 @@ double peak_rss_mib() {
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
   return double(usage.ru_maxrss) / 1024.0;
+}
+
+// What lights the image, in words: the lights it has, and the sky tracer adds to a path render of a
+// scene without an emissive surface (settings_for), said so that it is never taken for the file's.
+std::string lighting(const Scene& scene, const RenderSettings& settings, const RenderArgs& args) {
+  std::string out;
+  const auto add = [&](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
+  if (!scene.emitters.empty()) add(std::to_string(scene.emitters.size()) + " emissive triangles");
+  size_t points = 0;
+  for (const Light& l : scene.lights) points += l.is_point() ? 1 : 0;
+  if (points) add(std::to_string(points) + " point light" + (points > 1 ? "s" : ""));
+  if (settings.integrator == Integrator::Path || settings.integrator == Integrator::Whitted) {
+    if (!scene.environment_map.empty()) add("an environment map");
+    const Vec3 sky = settings.environment;
+    if (max_component(sky) > 0.0f) {
+      char text[96];
+      std::snprintf(text, sizeof text, "a uniform sky (%g, %g, %g)", double(sky.x), double(sky.y), double(sky.z));
+      add(text);
+      if (args.env.empty() && scene.emitters.empty() && scene.environment_map.empty()) {
+        out += " added by tracer: the scene has no emissive surface (--env 0,0,0 for none)";
+      }
+    }
+  } else if (settings.ambient > 0.0f) {
+    add("ambient " + format_number(settings.ambient));
+  }
+  return out.empty() ? "none" : out;
 }
 
 }  // namespace
@@ -37,6 +64,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
                       {"build_ms", accel.build_ms},
                       {"render_ms", render_ms},
                       {"integrator", name_of<Integrator>(kIntegratorNames, settings.integrator)},
+                      {"lighting", lighting(scene, settings, args)},
                       {"max_depth", settings.max_depth},
                       {"spp", settings.spp},
                       {"frames", args.frames},
@@ -91,6 +119,7 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   }
   std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
               str("output").c_str());
+  std::printf("lighting     %s\n", str("lighting").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
               !j["packets"].get<bool>()       ? ""
