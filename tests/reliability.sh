@@ -9,6 +9,7 @@ tracer=$(realpath "$1")
 tracer_mpi=$(dirname "$tracer")/tracer-mpi
 mode=${2:-}
 doc=${3:+$(realpath "$3")}
+shared_scenes=$(realpath "$(dirname "$0")/../../shared/scenes")
 work=$(mktemp -d)
 chmod 755 "$work"  # the unprivileged case must reach its file
 trap 'rm -rf "$work"' EXIT
@@ -31,10 +32,30 @@ gltf "$nodes"',{"mesh":0}]' 3 "$data" > expand.gltf
 mkdir gltfdir && mv tri.bin secret.bin
 gltf '[{"mesh":0}]' 3 "../secret.bin" > gltfdir/escape.gltf
 printf 'glTF\002\000\000\000\377\377\000\000\040\000\000\000JSON{"asset":' > cut.glb
+# The fifth round: what tinygltf read as absent, nesting, memory, URIs it called missing.
+deep=$(printf '%.0s[' $(seq 20000))$(printf '%.0s]' $(seq 20000))
+gltf '[{"mesh":0}]' 3 "$data" | sed "s/^{/{\"extras\":$deep,/" > deep.gltf
+gltf '[{"mesh":0}]' 3 "$data" | sed 's/"bufferView":0,/"bufferView":0,"byteOffset":-12,/' > offset.gltf
+gltf '[{"mesh":0}]' 3 "$data" | sed 's/"scene":0/"scene":5/' > scene5.gltf
+gltf '[{"mesh":0}]' 3 "$data" | sed 's/"componentType":5126/"componentType":5125/' > uintpos.gltf
+gltf '[{"mesh":0}]' 3 "/dev/zero" > devzero.gltf
+gltf '[{"mesh":0,"camera":0}]' 3 "$data" | sed 's/^{/{"cameras":[{"type":"perspective","perspective":{"znear":0.1}}],/' > noyfov.gltf
+gltf '[{"mesh":0,"camera":0}]' 3 "$data" | sed 's/^{/{"cameras":[{"type":"perspective","perspective":{"yfov":1e-30,"znear":0.1}}],/' > tinyfov.gltf
+gltf '[{"mesh":0}]' 3 "$data" | sed 's/"primitives":\[{/"primitives":[{"material":0,/; s/^{/{"materials":[{"emissiveFactor":[1,1,1],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":1e38}}}],/' > bright.gltf
+nodes='[{"children":[1,1]}'
+for i in $(seq 1 23); do nodes+=",{\"children\":[$((i + 1)),$((i + 1))]}"; done
+gltf "$nodes"',{"mesh":0}]' 3 "$data" > inst24.gltf
+ln -s "$shared_scenes" shared-scenes  # ../shared/scenes, the same name on every machine
+printf 'glTF\001\000\000\000\024\000\000\000\000\000\000\000JSON' > v1.glb
+: > empty.gltf
+: > empty.ply
+cp ok.obj ok.stl 2>/dev/null || printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > ok.stl
 ply='ply\nformat %s 1.0\nelement vertex %s\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > tri.ply
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 4000000000 > count.ply
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n' ascii 3 > range.ply
+printf "$ply"'0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > extra.ply
+printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float x\nend_header\n0 0\n' > twice.ply
 { printf "$ply" binary_little_endian 3; head -c 36 /dev/zero; printf '\003\0\0\0'; } > cut.ply
 printf 'mtllib dark.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 100 100 100\nv 101 100 100\nv 100 101 100\nf 1 2 3\nusemtl lamp\nf 4 6 5\n' > dark.obj
 printf 'newmtl lamp\nKe 10 10 10\n' > dark.mtl
@@ -248,6 +269,30 @@ cases=(
   "PLY: a vertex count the file cannot hold|tracer render count.ply -q|1"
   "PLY: a face index out of range|tracer render range.ply -q|1"
   "PLY: binary data cut short|tracer render cut.ply -q|1"
+  "glTF: JSON nested 20,000 levels deep in 40 KB|tracer render deep.gltf -q|1"
+  "glTF: an accessor byteOffset of -12|tracer render offset.gltf -q|1"
+  "glTF: a scene index that names no scene|tracer render scene5.gltf -q|1"
+  "glTF: UNSIGNED_INT positions|tracer render uintpos.gltf -q|1"
+  "glTF: a buffer URI /dev/zero|tracer render devzero.gltf -q|1"
+  "glTF: a perspective camera without yfov|tracer render noyfov.gltf -q|1"
+  "glTF: a yfov of 1e-30 (below --fov's range)|tracer render tinyfov.gltf -q|1"
+  "glTF: emissive strength 1e38 (above MTL's Ke limit)|tracer render bright.gltf -q|1"
+  "glTF: a GLB of version 1|tracer render v1.glb -q|1"
+  "glTF: an empty file|tracer render empty.gltf -q|1"
+  "glTF: 2^24 instances past --max-memory-mib 1024|tracer render inst24.gltf -q --max-memory-mib 1024|1"
+  "glTF: tracer info of 2^24 instances (each node counted once)|tracer info inst24.gltf > /dev/null|0"
+  "PLY: an extra value on a row|tracer render extra.ply -q|1"
+  "PLY: a property declared twice|tracer render twice.ply -q|1"
+  "PLY: an empty file|tracer render empty.ply -q|1"
+  "a scene of an unknown extension (.stl)|tracer render ok.stl -q|1"
+  "16384 x 16384 with three AOVs, past the memory limit|tracer render --width 16384 --height 16384 --aov albedo,normal,samples --max-memory-mib 16384 -q -o big.exr|2"
+  "a scene and its accelerator past --max-memory-mib|tracer render --builtin-spheres 200000 --max-memory-mib 48 --width 8 --height 8 -q|1"
+  "--max-memory-mib 0|tracer render --max-memory-mib 0 -q|2"
+  "--aperture 0.1 --focus-distance 1e-30|tracer render --aperture 0.1 --focus-distance 1e-30 -q|2"
+  "--build-quality HIGH (names are exact)|tracer render --build-quality HIGH -q|2"
+  "bench --build-quality high|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh8 --scenes ok.obj --build-quality high > /dev/null|0"
+  "tracer view: SIGINT 50 ms after start, in the background|tracer view ok.obj --port 0 -q > /dev/null & sleep 0.05 ; kill -INT \$! ; wait \$!|130"
+  "Ctrl-C while Sponza loads and builds at high quality|timeout --foreground --preserve-status -s INT 0.5 tracer render shared-scenes/sponza/sponza.obj --build-quality high -q|130"
   "all vertices coincide, no camera flags|tracer render same.obj -q|1"
   "control character in a number|tracer render control.obj -q|1"
   "UTF-8 byte-order mark, +1, 1e-50|tracer render bom.obj -q --width 32 --height 32|0"

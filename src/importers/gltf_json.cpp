@@ -406,6 +406,7 @@ std::optional<size_t> payload_index(std::string_view path) {
 
 PreparedJson prepare_json(std::string_view bytes, const std::string& name, WarningLog& warnings, CancelFlag cancel) {
   PreparedJson out;
+  if (bytes.empty()) throw InputError(name + ": an empty file, not a glTF file");
   if (bytes.size() >= 4 && le32(bytes, 0) == kGlbMagic) {
     if (bytes.size() < 20) return out;  // tinygltf names the truncation
     const uint32_t version = le32(bytes, 4);

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <filesystem>
 
+#include "base/errors.hpp"
 #include "importers/gltf_loader.hpp"
 #include "importers/obj_loader.hpp"
 #include "importers/ply_loader.hpp"
@@ -15,7 +16,8 @@ SceneFormat scene_format(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext == ".gltf" || ext == ".glb") return SceneFormat::Gltf;
   if (ext == ".ply") return SceneFormat::Ply;
-  return SceneFormat::Obj;
+  if (ext == ".obj" || ext.empty() || ext == ".") return SceneFormat::Obj;
+  throw InputError(path + ": unknown scene format '" + ext + "' (tracer reads .obj, .gltf, .glb and .ply)");
 }
 
 Scene load_scene_file(const std::string& path, const WarningSink& warn, CancelFlag cancel, const LoadLimits& limits,

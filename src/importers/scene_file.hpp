@@ -1,5 +1,6 @@
-// Which importer reads a scene file: by its extension (.obj, .gltf, .glb, .ply, in any case);
-// anything else, and standard input, is read as OBJ.
+// Which importer reads a scene file: by its extension (.obj, .gltf, .glb, .ply, in any case).
+// Standard input and a path without an extension (a pipe, /dev/fd/N) are read as OBJ; another
+// extension is refused (an .stl read as OBJ gave "no triangles" or, worse, an image).
 #pragma once
 
 #include <string>
@@ -12,6 +13,7 @@ namespace tracer {
 
 enum class SceneFormat { Obj, Gltf, Ply };
 
+// Throws InputError naming the file and the formats read for an unknown extension.
 SceneFormat scene_format(const std::string& path);
 
 // Loads `path` with the importer its format calls for (importers/obj_loader.hpp,
