@@ -262,7 +262,7 @@ cases=(
   "glTF: an accessor's count past its buffer|tracer render count.gltf -q|1"
   "glTF: a buffer URI that leaves the scene's folder|tracer render gltfdir/escape.gltf -q|1"
   "glTF: nodes in a cycle|tracer render cycle.gltf -q|1"
-  "glTF: 2^40 instances of a triangle in 1 KB|tracer render expand.gltf -q|1"
+  "glTF: 2^40 instances of a triangle in 1 KB|tracer render expand.gltf -q --max-memory-mib 1024|1"
   "glTF: a .glb cut short|tracer render cut.glb -q|1"
   "glTF: --camera of a scene without cameras|tracer render tri.gltf --camera 0 -q|2"
   "PLY: one triangle|tracer render tri.ply -q --width 32 --height 32 -o p.png|0"
