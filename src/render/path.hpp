@@ -95,9 +95,18 @@ void add_sampled_light(const Accel& accel, const LightSampler& lights, const Sur
   }
 }
 
+// The denoiser's features of a sample (film/feature_film.hpp), as Cycles' denoising features are
+// taken: at the first vertex that is not a mirror or glass, with the albedo times what the
+// specular bounces before it let through, so a reflection is guided by what it reflects. Where
+// the path ends before such a vertex, the last vertex's; zero where the camera ray escapes.
+struct GuideFeatures {
+  Vec3 albedo{0.0f}, normal{0.0f};
+  float distance = 0.0f;  // along the path, camera to the vertex
+};
+
 template <class Accel>
 Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PathSampler& sampler, RayCounts& counts,
-                   FirstHit* first = nullptr) {
+                   FirstHit* first = nullptr, GuideFeatures* guide = nullptr) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
   const LightSampler lights(ctx);
@@ -109,6 +118,8 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   float bsdf_pdf = 0.0f;
   Vec3 prev_n{0.0f};  // the geometric normal at the vertex the ray left, on its side
   RayCone cone{0.0f, ctx.camera.pixel_spread()};
+  float travelled = 0.0f;
+  bool guided = guide == nullptr;  // the guide's vertex found (or none asked for)
   for (int depth = 0;; ++depth) {
     // Each sample is drawn before the ray it waits for is traced, so that its hash chain runs in
     // the shadow of that traversal rather than after it (12 % more samples per second on the
@@ -140,6 +151,14 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
     const Vec3 kd = diffuse_color(scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
     const Bsdf bsdf = material_bsdf(mat, kd, si.shading_n, si.front);
     const Vec3 wo = -ray.dir;
+    if (!guided) {
+      travelled += hit.t;
+      const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
+      guide->albedo = beta * Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
+      guide->normal = si.shading_n;
+      guide->distance = travelled;
+      guided = !bsdf.delta();
+    }
     if (depth == 0 && first) {
       const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
       first->albedo = Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
@@ -183,6 +202,7 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
       if (ctx.active && !ctx.active->active(x, y)) continue;
       const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
       Vec3 sum{0.0f}, half{0.0f}, albedo{0.0f}, normal{0.0f};
+      FeatureFilm::PixelSums features;
       const bool aovs = ctx.albedo || ctx.normal;
       for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
         const PathSampler sampler(pixel, k, s.seed);
@@ -196,17 +216,20 @@ void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, R
         }
         ++counts.primary;
         FirstHit first;
-        const Vec3 l = path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr);
-        if (is_finite(l)) {
-          sum += l;
-          if (in_half(k)) half += l;
-        }
+        GuideFeatures guide;
+        Vec3 l =
+            path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr, ctx.features ? &guide : nullptr);
+        if (!is_finite(l)) l = Vec3{0.0f};
+        sum += l;
+        if (in_half(k)) half += l;
         albedo += first.albedo;
         normal += first.normal;
+        if (ctx.features) features.add({l, guide.albedo, guide.normal, guide.distance}, in_half(k));
       }
       ctx.framebuffer->add(x, y, sum, half, ctx.samples.count);
       if (ctx.albedo) ctx.albedo->add(x, y, albedo, ctx.samples.count);
       if (ctx.normal) ctx.normal->add(x, y, normal, ctx.samples.count);
+      if (ctx.features) ctx.features->add(x, y, features);
     }
   }
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "film/convergence.hpp"
+#include "film/feature_film.hpp"
 #include "film/framebuffer.hpp"
 #include "render/ray_counts.hpp"
 #include "render/render_settings.hpp"
@@ -29,6 +30,8 @@ struct RenderContext {
   // denoiser), summed and counted as the radiance is; null when not asked for.
   Framebuffer* albedo = nullptr;
   Framebuffer* normal = nullptr;
+  // path, --denoise: the halves of radiance and the denoiser's features (null when not asked for).
+  FeatureFilm* features = nullptr;
   // path with adaptive sampling: the pixels this pass samples (null: all of them).
   const ActivePixels* active = nullptr;
 };
