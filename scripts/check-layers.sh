@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # folder:layer, lowest first.
-layers="base:0 math:1 scene:2 parallel:2 importers:3 film:3 accel:3 io:4 shade:4 render:5 driver:6 view:7 mpi:7 cli:8"
+layers="base:0 math:1 scene:2 parallel:2 importers:3 film:3 accel:3 io:4 shade:4 denoise:4 render:5 driver:6 view:7 mpi:7 cli:8"
 declare -A rank
 for entry in $layers; do rank[${entry%%:*}]=${entry##*:}; done
 

@@ -1,0 +1,289 @@
+// The denoiser's per-tile loops (kernels.hpp), compiled once per SIMD target by Highway.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "denoise/kernels.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+// After highway.h, once per target (Highway's -inl convention).
+#include <hwy/contrib/math/math-inl.h>
+
+#include <utility>
+
+#include "denoise/kernels.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer::denoise {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+using D = hn::ScalableTag<float>;
+using V = hn::Vec<D>;
+
+// exp(-max(0, distance) * inv_k2) times valid: an NL-means weight. A weight below exp(-30)
+// (1e-13 of the centre's) is zero: the sums it would add to are far below float precision, and
+// products of such weights fall into denormals, which cost x86 a microcode assist each (they made
+// the regression eight times slower).
+HWY_INLINE V Weight(D d, V distance, V inv_k2, V valid) {
+  const V arg = hn::Neg(hn::Max(distance, hn::Zero(d))) * inv_k2;
+  const V cut = hn::Set(d, -30.0f);
+  return hn::IfThenElseZero(arg > cut, hn::Exp(d, hn::Max(arg, cut)) * valid);
+}
+
+void PatchDistances(const PatchDistance& a) {
+  const D d;
+  const size_t n = hn::Lanes(d);
+  const int f = a.patch, rows = kTileHeight + 2 * f, channels = a.guide->channels();
+  HWY_ALIGN float dist[(kTileHeight + 2 * kMaxPatch) * kPatchColumns];
+  HWY_ALIGN float hbox[(kTileHeight + 2 * kMaxPatch) * kTileWidth];
+  const V inv_channels = hn::Set(d, 1.0f / float(channels));
+  const V eps = hn::Set(d, 1e-10f), clamp = hn::Set(d, 10000.0f);
+  // The columns the box filter reads, in whole vectors (at most kPatchColumns).
+  const size_t columns = (size_t(kTileWidth + 2 * f) + n - 1) / n * n;
+  for (int r = 0; r < rows; ++r) {
+    const int y = a.y0 - f + r;
+    for (size_t i = 0; i < columns; i += n) {
+      const int x = a.x0 - f + int(i);
+      V sum = hn::Zero(d);
+      for (int c = 0; c < channels; ++c) {
+        const V gp = hn::LoadU(d, a.guide->at(c, x, y));
+        const V gq = hn::LoadU(d, a.guide->at(c, x + a.ox, y + a.oy));
+        const V vp = hn::LoadU(d, a.variance->at(c, x, y));
+        const V vq = hn::LoadU(d, a.variance->at(c, x + a.ox, y + a.oy));
+        const V diff = gp - gq;
+        const V num = hn::MulSub(diff, diff, vp + hn::Min(vp, vq));
+        // A reciprocal estimate refined by one Newton step (relative error about 1e-7), not a
+        // division: the divider's throughput was a third of the denoiser's time.
+        const V den = vp + vq + eps;
+        const V r0 = hn::ApproximateReciprocal(den);
+        const V inv = r0 * hn::NegMulAdd(den, r0, hn::Set(d, 2.0f));
+        sum = sum + hn::Min(num * inv, clamp);
+      }
+      hn::Store(sum * inv_channels, d, dist + r * kPatchColumns + int(i));
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    for (size_t i = 0; i < size_t(kTileWidth); i += n) {
+      V sum = hn::Zero(d);
+      for (int j = 0; j <= 2 * f; ++j) sum = sum + hn::LoadU(d, dist + r * kPatchColumns + int(i) + j);
+      hn::Store(sum, d, hbox + r * kTileWidth + int(i));
+    }
+  }
+  const V inv_area = hn::Set(d, 1.0f / float((2 * f + 1) * (2 * f + 1)));
+  for (int y = 0; y < kTileHeight; ++y) {
+    for (size_t i = 0; i < size_t(kTileWidth); i += n) {
+      V sum = hn::Zero(d);
+      for (int j = 0; j <= 2 * f; ++j) sum = sum + hn::Load(d, hbox + (y + j) * kTileWidth + int(i));
+      hn::Store(sum * inv_area, d, a.out + y * kTileWidth + int(i));
+    }
+  }
+}
+
+void FilterStepT(const FilterStep& a) {
+  const D d;
+  const size_t n = hn::Lanes(d);
+  const int channels = a.image->channels();
+  const V inv_k2 = hn::Set(d, a.inv_k2);
+  for (int ty = 0; ty < kTileHeight; ++ty) {
+    const int y = a.y0 + ty;
+    for (size_t i = 0; i < size_t(kTileWidth); i += n) {
+      const int x = a.x0 + int(i), idx = ty * kTileWidth + int(i);
+      const V w = Weight(d, hn::Load(d, a.distance + idx), inv_k2, hn::LoadU(d, a.valid->at(0, x + a.ox, y + a.oy)));
+      for (int c = 0; c < channels; ++c) {
+        float* acc = a.acc + c * kTilePixels + idx;
+        hn::Store(hn::MulAdd(w, hn::LoadU(d, a.image->at(c, x + a.ox, y + a.oy)), hn::Load(d, acc)), d, acc);
+      }
+      float* wsum = a.acc + channels * kTilePixels + idx;
+      hn::Store(hn::Load(d, wsum) + w, d, wsum);
+    }
+  }
+}
+
+// Where row r of X^T W X starts among the upper triangle's entries.
+constexpr int GramRowStart(int r) { return r * kDim - r * (r - 1) / 2; }
+
+// What a row-vector of pixels reads at each offset.
+struct RowView {
+  const float* features[kFeatures];  // at p
+  const float* image[3];             // at p
+  ptrdiff_t stride;
+  int radius;
+  float scale;
+};
+
+// Adds row R of X^T W X and of X^T W Y over every offset, for B bandwidths at once (the
+// regressors loaded once for both), in registers, and stores them to sums[b]
+// (kRegressionEntries vectors of the row-vector each).
+template <int B, int R>
+HWY_INLINE void AccumulateRow(D d, const RowView& v, const V* fp, const float* weights, size_t weight_stride,
+                              float* sums, size_t sums_stride) {
+  constexpr int kS = kDim - R;
+  const size_t n = hn::Lanes(d);
+  V acc[B][kS + 3];
+  for (int b = 0; b < B; ++b) {
+    for (int k = 0; k < kS + 3; ++k) acc[b][k] = hn::Zero(d);
+  }
+  int o = 0;
+  for (int oy = -v.radius; oy <= v.radius; ++oy) {
+    for (int ox = -v.radius; ox <= v.radius; ++ox, ++o) {
+      const ptrdiff_t q = ptrdiff_t(oy) * v.stride + ox;
+      V x[kS];
+      HWY_UNROLL(16)
+      for (int k = 0; k < kS; ++k) {
+        const int s = R + k;
+        x[k] = s == 0   ? hn::Set(d, 1.0f)
+               : s == 1 ? hn::Set(d, float(ox) * v.scale)
+               : s == 2 ? hn::Set(d, float(oy) * v.scale)
+                        : hn::LoadU(d, v.features[s - 3] + q) - fp[s - 3];
+      }
+      V y[3];
+      for (int c = 0; c < 3; ++c) y[c] = hn::LoadU(d, v.image[c] + q);
+      HWY_UNROLL(2)
+      for (int b = 0; b < B; ++b) {
+        const V wr = hn::Load(d, weights + size_t(b) * weight_stride + size_t(o) * n) * x[0];
+        HWY_UNROLL(16)
+        for (int k = 0; k < kS; ++k) acc[b][k] = hn::MulAdd(wr, x[k], acc[b][k]);
+        for (int c = 0; c < 3; ++c) acc[b][kS + c] = hn::MulAdd(wr, y[c], acc[b][kS + c]);
+      }
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    float* out = sums + size_t(b) * sums_stride;
+    for (int k = 0; k < kS; ++k) hn::Store(acc[b][k], d, out + size_t(GramRowStart(R) + k) * n);
+    for (int c = 0; c < 3; ++c) hn::Store(acc[b][kS + c], d, out + size_t(kGramEntries + R * 3 + c) * n);
+  }
+}
+
+template <int B, int... R>
+HWY_INLINE void AccumulateRows(D d, const RowView& v, const V* fp, const float* weights, size_t weight_stride,
+                               float* sums, size_t sums_stride, std::integer_sequence<int, R...>) {
+  (AccumulateRow<B, R>(d, v, fp, weights, weight_stride, sums, sums_stride), ...);
+}
+
+// beta's first term for each lane from the sums (see RegressionRow), by a Cholesky factorisation
+// lane by lane; the weighted mean where it fails.
+HWY_INLINE void SolveLanes(D d, const float* sums, float* l, V out[3]) {
+  const size_t n = hn::Lanes(d);
+  const auto gram = [&](int r, int s) {
+    const int a = r < s ? r : s, b = r < s ? s : r;
+    return hn::Load(d, sums + size_t(GramRowStart(a) + b - a) * n);
+  };
+  const auto rhs = [&](int r, int c) { return hn::Load(d, sums + size_t(kGramEntries + r * 3 + c) * n); };
+  const V weights = gram(0, 0);
+  const V ridge = weights * hn::Set(d, 1e-3f);
+  const V floor = weights * hn::Set(d, 1e-6f);
+  auto ok = weights > hn::Zero(d);
+  const auto lv = [&](int r, int s) { return l + size_t(r * kDim + s) * n; };
+  for (int j = 0; j < kDim; ++j) {
+    V s = gram(j, j);
+    if (j > 0) s = s + ridge;
+    for (int k = 0; k < j; ++k) {
+      const V ljk = hn::Load(d, lv(j, k));
+      s = hn::NegMulAdd(ljk, ljk, s);
+    }
+    ok = hn::And(ok, s > floor);
+    const V ljj = hn::Sqrt(hn::Max(s, floor + hn::Set(d, 1e-30f)));
+    hn::Store(ljj, d, lv(j, j));
+    const V inv = hn::Set(d, 1.0f) / ljj;
+    for (int r = j + 1; r < kDim; ++r) {
+      V t = gram(r, j);
+      for (int k = 0; k < j; ++k) t = hn::NegMulAdd(hn::Load(d, lv(r, k)), hn::Load(d, lv(j, k)), t);
+      hn::Store(t * inv, d, lv(r, j));
+    }
+  }
+  const V safe_weights = hn::Max(weights, hn::Set(d, 1e-30f));
+  for (int c = 0; c < 3; ++c) {
+    V z[kDim], beta[kDim];
+    for (int r = 0; r < kDim; ++r) {
+      V t = rhs(r, c);
+      for (int k = 0; k < r; ++k) t = hn::NegMulAdd(hn::Load(d, lv(r, k)), z[k], t);
+      z[r] = t / hn::Load(d, lv(r, r));
+    }
+    for (int r = kDim - 1; r >= 0; --r) {
+      V t = z[r];
+      for (int k = r + 1; k < kDim; ++k) t = hn::NegMulAdd(hn::Load(d, lv(k, r)), beta[k], t);
+      beta[r] = t / hn::Load(d, lv(r, r));
+    }
+    const V mean = rhs(0, c) / safe_weights;
+    const auto finite = hn::IsFinite(beta[0]);
+    out[c] = hn::Max(hn::IfThenElse(hn::And(ok, finite), beta[0], mean), hn::Zero(d));
+  }
+}
+
+void RegressionRowT(const RegressionRow& a) {
+  const D d;
+  const size_t n = hn::Lanes(d);
+  const int edge = 2 * a.radius + 1, offsets = edge * edge;
+  float* weights = a.scratch;                                  // bandwidths x offsets vectors
+  float* sums = weights + size_t(a.bandwidths * offsets) * n;  // kRegressionEntries vectors a bandwidth
+  float* l = sums + size_t(2 * kRegressionEntries) * n;        // kDim x kDim vectors
+  const int y = a.y0 + a.ty;
+  for (size_t i = 0; i < size_t(kTileWidth); i += n) {
+    const int x = a.x0 + int(i);
+    if (x >= a.image->width()) break;
+    RowView v;
+    v.stride = a.image->stride();
+    v.radius = a.radius;
+    v.scale = a.position_scale;
+    V fp[kFeatures];
+    for (int j = 0; j < kFeatures; ++j) {
+      v.features[j] = a.features->at(j, x, y);
+      fp[j] = hn::LoadU(d, v.features[j]);
+    }
+    for (int c = 0; c < 3; ++c) v.image[c] = a.image->at(c, x, y);
+    const float* valid = a.valid->at(0, x, y);
+    for (int o = 0; o < offsets; ++o) {
+      const int ox = o % edge - a.radius, oy = o / edge - a.radius;
+      const V dist = hn::Load(d, a.distances + size_t(o) * kTilePixels + size_t(a.ty) * kTileWidth + i);
+      const V ok = hn::LoadU(d, valid + ptrdiff_t(oy) * v.stride + ox);
+      for (int b = 0; b < a.bandwidths; ++b) {
+        hn::Store(Weight(d, dist, hn::Set(d, a.inv_k2[b]), ok), d, weights + size_t(b * offsets + o) * n);
+      }
+    }
+    const size_t weight_stride = size_t(offsets) * n, sums_stride = size_t(kRegressionEntries) * n;
+    // Both bandwidths in one sweep where the registers hold their sums (AVX-512's 32); on
+    // narrower targets the second set of sums would spill, so each takes a sweep of its own.
+    constexpr bool kSweepBoth = HWY_TARGET <= HWY_AVX3;
+    if (a.bandwidths == 2 && !kSweepBoth) {
+      AccumulateRows<1>(d, v, fp, weights, weight_stride, sums, sums_stride, std::make_integer_sequence<int, kDim>{});
+      AccumulateRows<1>(d, v, fp, weights + weight_stride, weight_stride, sums + sums_stride, sums_stride,
+                        std::make_integer_sequence<int, kDim>{});
+    } else if (a.bandwidths == 2) {
+      AccumulateRows<2>(d, v, fp, weights, weight_stride, sums, sums_stride, std::make_integer_sequence<int, kDim>{});
+    } else {
+      AccumulateRows<1>(d, v, fp, weights, weight_stride, sums, sums_stride, std::make_integer_sequence<int, kDim>{});
+    }
+    for (int b = 0; b < a.bandwidths; ++b) {
+      V out[3];
+      SolveLanes(d, sums + size_t(b) * sums_stride, l, out);
+      HWY_ALIGN float lanes[3][16];
+      for (int c = 0; c < 3; ++c) hn::Store(out[c], d, lanes[c]);
+      for (size_t k = 0; k < n && x + int(k) < a.image->width(); ++k) {
+        for (int c = 0; c < 3; ++c) (*a.out[b])(c, x + int(k), y) = lanes[c][k];
+      }
+    }
+  }
+}
+
+const char* KernelTarget() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer::denoise
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer::denoise {
+
+HWY_EXPORT(PatchDistances);
+HWY_EXPORT(FilterStepT);
+HWY_EXPORT(RegressionRowT);
+HWY_EXPORT(KernelTarget);
+
+void patch_distances(const PatchDistance& a) { HWY_DYNAMIC_DISPATCH(PatchDistances)(a); }
+void filter_step(const FilterStep& a) { HWY_DYNAMIC_DISPATCH(FilterStepT)(a); }
+void regression_row(const RegressionRow& a) { HWY_DYNAMIC_DISPATCH(RegressionRowT)(a); }
+size_t regression_scratch_floats(int radius) {
+  const size_t widest = 16, offsets = size_t(2 * radius + 1) * size_t(2 * radius + 1);
+  return widest * (2 * offsets + size_t(2 * kRegressionEntries) + size_t(kDim * kDim));
+}
+const char* kernel_target() { return HWY_DYNAMIC_DISPATCH(KernelTarget)(); }
+
+}  // namespace tracer::denoise
+#endif  // HWY_ONCE
