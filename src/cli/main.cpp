@@ -59,11 +59,13 @@ int cmd_render(const RenderArgs& args) {
   const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
     return render_round(accel, ctx, passes, setup.sched, control);
   };
-  const FrameSequence frames{args.output,         args.frames,       args.orbit,    args.checkpoint,
-                             exr_pixel_for(args), args.save_partial, aovs_for(args)};
-  const DriveResult r = drive_render(scene, setup.camera, settings, frames,
-                                     {.holds_image = true, .round_per_pass = true, .cancel = cancel}, round,
-                                     [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
+  const FrameSequence frames{args.output,         args.frames,       args.orbit,     args.checkpoint,
+                             exr_pixel_for(args), args.save_partial, aovs_for(args), args.denoise};
+  const Executor denoiser(setup.sched.kind, setup.sched.threads);
+  const DriveResult r =
+      drive_render(scene, setup.camera, settings, frames,
+                   {.holds_image = true, .round_per_pass = true, .cancel = cancel, .denoiser = &denoiser}, round,
+                   [](const std::string& w) { std::cerr << "tracer: warning: " << w << "\n"; });
   if (r.stopped) {
     progress.stop();
     std::cerr << "tracer: " << stop_signal_name();
@@ -81,13 +83,14 @@ int cmd_render(const RenderArgs& args) {
   }
   const int checkpoints = r.checkpoints;
   progress.stop();
-  const double render_ms = ms_since(t_render);
+  const double render_ms = ms_since(t_render) - r.denoise_ms;
   const QueryCounts traversal = control.traversal.load();
   nlohmann::json stats =
       render_stats(scene, settings, accel, setup.sched, args, setup.load_ms, render_ms, control.counts.load(),
                    args.scene.scene.empty() && args.scene.view.empty() ? nullptr : &setup.load_phases,
                    settings.count_traversal ? &traversal : nullptr);
   stats["checkpoints_written"] = checkpoints;
+  if (args.denoise) stats["denoise_ms"] = r.denoise_ms;
   if (args.stats) print_stats(stats, accel);
   write_stats_json(args.stats_json, stats);
   return 0;

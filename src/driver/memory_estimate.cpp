@@ -15,9 +15,10 @@ uint64_t memory_limit(const SceneArgs& args) {
 uint64_t film_bytes(const RenderArgs& args) {
   const RenderSettings settings = settings_for(args);
   const Aovs aovs = aovs_for(args);
-  const uint64_t layers = uint64_t(aovs.albedo) + uint64_t(aovs.normal) + uint64_t(aovs.samples);
-  const uint64_t per_pixel =
-      kFilmBytesPerPixel + (adaptive(settings) ? kHalvesBytesPerPixel : 0) + layers * kLayerBytesPerPixel;
+  const uint64_t layers = uint64_t(aovs.albedo) + uint64_t(aovs.normal) + uint64_t(aovs.samples) +
+                          uint64_t(aovs.noisy) + uint64_t(aovs.variance);
+  const uint64_t per_pixel = kFilmBytesPerPixel + (adaptive(settings) ? kHalvesBytesPerPixel : 0) +
+                             layers * kLayerBytesPerPixel + (args.denoise ? kDenoiseBytesPerPixel : 0);
   return uint64_t(settings.width) * uint64_t(settings.height) * per_pixel;
 }
 
@@ -26,8 +27,9 @@ void check_film_fits(const RenderArgs& args, uint64_t limit) {
   if (bytes <= limit) return;
   std::string what = "--width " + std::to_string(args.settings.width) + " --height " +
                      std::to_string(args.settings.height) + (args.aov.empty() ? "" : " --aov " + args.aov) +
-                     ": the image's film";
+                     (args.denoise ? " --denoise" : "") + ": the image's film";
   if (!args.aov.empty()) what += " and layers";
+  if (args.denoise) what += " and the denoiser's";
   if (adaptive(settings_for(args))) what += " (with adaptive sampling's, --noise-threshold)";
   throw UsageError(memory_refusal(what, bytes, limit));
 }

@@ -115,8 +115,12 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
       "path, whitted: radiance r,g,b of a uniform environment, or the --env-map's scale (default black, 1,1,1 "
       "with --env-map; white when the scene has no light)");
   app.add_option("--aov", a.aov,
-                 "path: also write these layers into the .exr output: albedo and normal of the first hit (for a "
-                 "denoiser), samples (each pixel's sample count); comma-separated");
+                 "path: also write these layers into the .exr output: albedo and normal of the first hit, samples "
+                 "(each pixel's sample count), and with --denoise noisy (the image before denoising) and variance "
+                 "(of each pixel's mean); comma-separated");
+  app.add_flag("--denoise", a.denoise,
+               "path: denoise the image (NFOR, a feature-guided regression on the albedo, normal and distance of "
+               "the first surface that is not a mirror or glass); --aov noisy,variance keep what it started from");
   app.add_option("--light-sampling", a.light_sampling,
                  "path: " + names_of<LightSampling>(kLightSamplingNames) +
                      " (mis: emitter samples and BSDF samples combined; bsdf: BSDF samples only)")
@@ -214,6 +218,9 @@ void validate(const RenderArgs& a) {
   sched_options_for(a);
   simd_target_for(a);
   settings_for(a);
+  if (a.denoise && a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {
+    throw UsageError("--denoise: only for --integrator path (it is guided by path tracing's features)");
+  }
   exr_pixel_for(a);
   aovs_for(a);
 }

@@ -72,7 +72,8 @@ struct RenderArgs {
   std::optional<int> threads;
   std::string output = "render.png";
   bool stats = false, quiet = false, save_partial = false;
-  bool count = false;  // --count: traversal counters in the statistics
+  bool count = false;    // --count: traversal counters in the statistics
+  bool denoise = false;  // --denoise: path: the image denoised (denoise/nfor.hpp)
   std::string stats_json;
 };
 

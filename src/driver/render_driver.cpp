@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "denoise/nfor.hpp"
 #include "driver/output_checks.hpp"
 #include "driver/render_args.hpp"
 #include "driver/render_options.hpp"
@@ -27,7 +28,9 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
   for (int frame = 0; frame < seq.frames; ++frame) {
     const std::string output = frame_output(seq.output, frame, seq.frames);
     std::optional<Framebuffer> fb, albedo, normal;
+    std::optional<FeatureFilm> features;
     if (options.holds_image) fb.emplace(settings.width, settings.height);
+    if (options.holds_image && seq.denoise) features.emplace(settings.width, settings.height);
     if (fb && adaptive(settings)) fb->keep_halves();
     if (options.holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
     if (options.holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
@@ -35,6 +38,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
     ctx.albedo = albedo ? &*albedo : nullptr;
     ctx.normal = normal ? &*normal : nullptr;
+    ctx.features = features ? &*features : nullptr;
     std::vector<ExrLayer> layers;
     if (albedo) layers.push_back({"albedo", &*albedo, {"R", "G", "B"}});
     if (normal) layers.push_back({"normal", &*normal, {"X", "Y", "Z"}});
@@ -43,13 +47,38 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
       counts.emplace(settings.width, settings.height);
       layers.push_back({"samples", &*counts, {"Y", nullptr, nullptr}});
     }
-    const auto write = [&] {
+    std::optional<Framebuffer> denoised, variance;
+    if (features) {
+      denoised.emplace(settings.width, settings.height);
+      if (seq.aovs.noisy) layers.push_back({"noisy", &*fb, {"R", "G", "B"}});
+      if (seq.aovs.variance) {
+        variance.emplace(settings.width, settings.height);
+        layers.push_back({"variance", &*variance, {"R", "G", "B"}});
+      }
+    }
+    // `final_image`: a whole pass or more; a stop's partial image is written as it is.
+    const auto write = [&](bool final_image = true) {
       if (counts) {
         for (int y = 0; y < fb->height(); ++y) {
           for (int x = 0; x < fb->width(); ++x) counts->set(x, y, Vec3{float(fb->samples(x, y))});
         }
       }
-      const size_t clamped = write_render(output, *fb, settings.exposure, seq.exr, layers);
+      const Framebuffer* image = &*fb;
+      if (features && final_image) {
+        const auto start = Clock::now();
+        const std::vector<Vec3> d = denoise::nfor(*features, *options.denoiser, options.cancel);
+        result.denoise_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        for (int y = 0; y < fb->height(); ++y) {
+          for (int x = 0; x < fb->width(); ++x) denoised->set(x, y, d[size_t(y) * size_t(fb->width()) + size_t(x)]);
+        }
+        if (variance) {
+          for (int y = 0; y < fb->height(); ++y) {
+            for (int x = 0; x < fb->width(); ++x) variance->set(x, y, features->variance_of_mean(x, y));
+          }
+        }
+        image = &*denoised;
+      }
+      const size_t clamped = write_render(output, *image, settings.exposure, seq.exr, layers);
       if (clamped > 0 && !warned_clamped) {
         warn(output + ": " + std::to_string(clamped) + " pixel values beyond the " +
              (seq.exr == ExrPixel::Half ? "half EXR's range (65504; --exr float holds up to 3.4e38)"
@@ -70,7 +99,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
         // (With adaptive sampling the passes finished: pixels that stopped earlier hold fewer.)
         result.samples = adaptive(settings) ? done : fb->min_samples();
         if (result.samples > 0 || (seq.save_partial && fb->max_samples() > 0)) {
-          write();
+          write(/*final_image=*/false);
           result.wrote_partial = true;
         }
         return result;

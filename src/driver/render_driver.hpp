@@ -12,15 +12,17 @@
 
 #include "base/errors.hpp"
 #include "io/exr_io.hpp"
+#include "parallel/executor.hpp"
 #include "render/render_image.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer::driver {
 
-// The --aov layers: first-hit albedo and shading normal, for a denoiser; each pixel's sample
-// count (where adaptive sampling stopped).
+// The --aov layers: first-hit albedo and shading normal; each pixel's sample count (where
+// adaptive sampling stopped); with --denoise, the image before denoising and the variance of
+// each pixel's mean.
 struct Aovs {
-  bool albedo = false, normal = false, samples = false;
+  bool albedo = false, normal = false, samples = false, noisy = false, variance = false;
 };
 
 struct FrameSequence {
@@ -31,6 +33,7 @@ struct FrameSequence {
   ExrPixel exr = ExrPixel::Half;
   bool save_partial = false;  // on a stop, write finished tiles of a frame with no complete pass
   Aovs aovs;                  // --aov: layers written into the EXR beside the radiance
+  bool denoise = false;       // --denoise: every image written is denoise::nfor's of the film
 };
 
 // Renders the passes of `round` of the frame `ctx` describes into ctx.framebuffer (null on a rank
@@ -46,6 +49,7 @@ struct DriveResult {
   std::string output;
   uint32_t samples = 0;
   bool wrote_partial = false;
+  double denoise_ms = 0.0;  // --denoise: time spent denoising, every write included
 };
 
 // How this process takes part in a render.
@@ -54,6 +58,7 @@ struct DriveOptions {
   bool round_per_pass = true;  // each pass a round of its own (checkpoints, Ctrl-C after the first
                                // pass), else one round of every pass
   CancelFlag cancel = nullptr;
+  const Executor* denoiser = nullptr;  // runs the denoiser (needed with FrameSequence::denoise)
 };
 
 // Drives every frame. `warn` receives one-line warnings.

@@ -75,8 +75,11 @@ Aovs aovs_for(const RenderArgs& a) {
       aovs.normal = true;
     } else if (name == "samples") {
       aovs.samples = true;
+    } else if (name == "noisy" || name == "variance") {
+      if (!a.denoise) throw UsageError("--aov " + name + ": only with --denoise");
+      (name == "noisy" ? aovs.noisy : aovs.variance) = true;
     } else {
-      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal, samples)");
+      throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal, samples, noisy, variance)");
     }
   }
   if (a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {

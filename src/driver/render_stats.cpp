@@ -142,6 +142,7 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("\n");
   std::printf("build        %10.2f ms\n", j["build_ms"].get<double>());
   std::printf("render       %10.2f ms\n", j["render_ms"].get<double>());
+  if (j.contains("denoise_ms")) std::printf("denoise      %10.2f ms\n", j["denoise_ms"].get<double>());
   const auto& r = j["rays"];
   std::printf("rays         %llu primary, %llu shadow, %llu AO, %llu reflected/refracted/bounced, %llu total\n",
               r["primary"].get<unsigned long long>(), r["shadow"].get<unsigned long long>(),
