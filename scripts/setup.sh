@@ -40,5 +40,5 @@ fi
 
 cmake --preset release
 cmake --build --preset release
-./build/release/tracer render -o render.png --stats
+./build/release/tracer render -o render.png --denoise --stats
 echo "tracer: wrote render.png"
