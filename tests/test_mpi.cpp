@@ -137,6 +137,24 @@ TEST_F(MpiRender, AdaptiveSamplingStopsTheSamePixelsAsOneProcess) {
   }
 }
 
+TEST_F(MpiRender, DenoisedImageIsTheSameAsOneProcess) {
+  // The workers send each tile's features with its sums; rank 0 denoises the gathered film:
+  // byte for byte the image of one process, whatever the ranks, threads, tiles and rounds.
+  const std::string common = " --integrator path --denoise --width 40 --height 30 -q --exr float";
+  for (const std::string extra : {" --spp 6", " --noise-threshold 0.05 --min-spp 2 --spp 12"}) {
+    const auto r = test::run_tracer("render" + common + extra + " -o " + dir_ + "/ref.exr");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const auto& [ranks, flags] : {std::pair{2, " --threads 1 --tile 7"},
+                                       {3, " --threads 2 --tile 5 --sched queue"},
+                                       {2, " --threads 2 --tile 9 --checkpoint 1000"}}) {
+      SCOPED_TRACE(std::to_string(ranks) + flags + extra);
+      const auto m = run(mpirun(ranks) + kMpiExe + " render" + common + extra + flags + " -o " + dir_ + "/mpi.exr");
+      ASSERT_EQ(m.exit_code, 0) << m.output;
+      EXPECT_TRUE(same_bytes(read_file(dir_ + "/mpi.exr"), read_file(dir_ + "/ref.exr")));
+    }
+  }
+}
+
 TEST_F(MpiRender, FramesAreTheSameAsOneProcess) {
   const std::string common = " --integrator path --spp 2 --width 24 --height 18 -q --frames 3 --orbit 120 -o ";
   const auto r = test::run_tracer("render" + common + dir_ + "/one.png");
@@ -368,6 +386,7 @@ TEST_F(MpiRender, ARankWithOtherFlagsOrSettingsEndsTheJobWithOneError) {
       {" --eye 0,1,4", false, "renders with --eye "},
       {" --seed 7", false, "renders with --seed "},
       {" --tile 8", false, "renders with --tile "},
+      {" --denoise", true, "--denoise: only for --integrator path"},
   };
   for (const auto& c : cases) {
     for (const auto& [ranks, odd] : {std::pair{2, 1}, {3, 2}, {3, 0}}) {

@@ -83,12 +83,14 @@ class FeatureFilm {
     }
     return v;
   }
-  // Makes the pixels of `tile` hold what `from`'s hold (a window another rank rendered).
-  void copy_tile(const FeatureFilm& from, const Tile& tile) {
+  // Adds to the pixels of `tile` what `from`'s hold (a window another rank rendered: its sums
+  // of this pass, added as path_tile adds them).
+  void add_tile(const FeatureFilm& from, const Tile& tile) {
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x = tile.x0; x < tile.x1; ++x) {
         const float* src = from.v_.data() + from.offset(x, y);
-        std::copy(src, src + kPixelFloats, pixel(x, y));
+        float* dst = pixel(x, y);
+        for (int i = 0; i < kPixelFloats; ++i) dst[i] += src[i];
       }
     }
   }

@@ -57,14 +57,17 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const driver::PreparedRender& prepared = *setup.prepared;
   RankRender rank(prepared, args, session, std::move(agreement.threads), rank_timeout, watch_phase);
   // Signals end a rank at once (install_immediate_stop_handlers): no round is ever stopped.
-  const driver::FrameSequence frames{args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args),
-                                     false};
+  const driver::FrameSequence frames{
+      args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args), false, {}, args.denoise};
+  // Rank 0 denoises the gathered film with its own threads.
+  const Executor denoiser(prepared.sched.kind, prepared.sched.threads);
   const driver::DriveResult driven = driver::drive_render(
       prepared.scene, prepared.camera, prepared.settings, frames,
       // Adaptive sampling decides between passes, from rank 0's image: a round per pass.
       {.holds_image = session.root(),
        .round_per_pass = args.checkpoint.has_value() || adaptive(prepared.settings),
-       .cancel = nullptr},
+       .cancel = nullptr,
+       .denoiser = &denoiser},
       [&](const RenderContext& ctx, const std::vector<SampleRange>& round) { return rank.render_round(ctx, round); },
       [](const std::string& w) { say("tracer-mpi: warning: " + w); });
   rank.report_late_ranks();

@@ -21,11 +21,12 @@ namespace tracer::mpi {
 namespace {
 
 // Renders the passes of `round` of one tile, in order, into `fb` (rank 0's image, or a window for
-// the tile).
+// the tile) and, with --denoise, `features` (likewise).
 RayCounts render_one(const Accelerator& accel, const RenderContext& ctx, const std::vector<SampleRange>& round,
-                     Framebuffer& fb, const Tile& tile) {
+                     Framebuffer& fb, FeatureFilm* features, const Tile& tile) {
   RenderContext c = ctx;
   c.framebuffer = &fb;
+  c.features = features;
   RayCounts counts;
   for (const SampleRange& pass : round) {
     c.samples = pass;
@@ -101,22 +102,25 @@ void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleR
           [&](const TileGrant& g) {
             const Tile& t = tiles_[g.tile];
             if (!g.reissued) {
-              count(render_one(setup_.accel, ctx, round, fb, t), t, samples);
+              count(render_one(setup_.accel, ctx, round, fb, ctx.features, t), t, samples);
               server.own_done(g.tile);
               return;
             }
             // Taken back from a late rank: its copy may still come, so render apart.
             Framebuffer window(t);
             if (fb.has_halves()) window.keep_halves();
-            count(render_one(setup_.accel, ctx, round, window, t), t, samples);
-            server.commit(g.tile, window, fb, samples);
+            std::optional<FeatureFilm> window_features;
+            if (ctx.features) window_features.emplace(t);
+            count(render_one(setup_.accel, ctx, round, window, window_features ? &*window_features : nullptr, t), t,
+                  samples);
+            server.commit(g.tile, window, fb, samples, window_features ? &*window_features : nullptr, ctx.features);
           });
     } catch (...) {
       own_failure = std::current_exception();
     }
   });
   try {
-    server.serve(fb, samples);
+    server.serve(fb, samples, ctx.features);
   } catch (const RankFailed& e) {
     if (progress_) progress_->stop();
     say("tracer-mpi: error: rank " + std::to_string(e.rank) + " of " + std::to_string(session_.size()) + ": " +
@@ -147,17 +151,19 @@ void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRa
       TileClient::Worker worker(client, thread_ids.fetch_add(1));
       std::optional<uint32_t> finished;
       std::unique_ptr<Framebuffer> result;
-      ActivePixels active;  // this thread's tiles' blocks
+      std::unique_ptr<FeatureFilm> features;  // --denoise: the tile's features, sent with its sums
+      ActivePixels active;                    // this thread's tiles' blocks
       RenderContext c = ctx;
       if (masks) c.active = &active;
       double idle = 0;
-      while (const std::optional<uint32_t> next = worker.next(finished, result.get(), idle)) {
+      while (const std::optional<uint32_t> next = worker.next(finished, result.get(), features.get(), idle)) {
         const Tile& t = tiles_[*next];
         result = std::make_unique<Framebuffer>(t);
         if (adaptive(ctx.settings)) result->keep_halves();
+        if (args_.denoise) features = std::make_unique<FeatureFilm>(t);
         if (masks) active.set_window_blocks(ctx.settings.width, ctx.settings.height, t, worker.mask());
         const auto t0 = Clock::now();
-        count(render_one(setup_.accel, c, round, *result, t), t, samples);
+        count(render_one(setup_.accel, c, round, *result, features.get(), t), t, samples);
         const double took = ms_since(t0) * 1e-3;
         for (double seen = slowest_tile_s_.load(); took > seen && !slowest_tile_s_.compare_exchange_weak(seen, took);) {
         }

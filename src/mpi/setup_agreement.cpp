@@ -47,9 +47,9 @@ std::string settings_fingerprint(const driver::PreparedRender& s, const driver::
     << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
     << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--aperture " << s.camera.lens_radius
     << "\n--focus-distance " << s.camera.focus_distance << "\n--frames " << args.frames << "\n--orbit " << args.orbit
-    << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--sched "
-    << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block
-    << "\n";
+    << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--denoise " << (args.denoise ? "on" : "off")
+    << "\n--sched " << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block "
+    << s.sched.block << "\n";
   return f.str();
 }
 

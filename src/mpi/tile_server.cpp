@@ -99,7 +99,8 @@ void TileServer::add_pixel(Framebuffer& fb, int x, int y, Vec3 sum, Vec3 half, u
   fb.add(x, y, sum, half, active_ && !active_->active(x, y) ? 0u : samples);
 }
 
-void TileServer::commit(uint32_t t, const Framebuffer& window, Framebuffer& fb, uint32_t samples) {
+void TileServer::commit(uint32_t t, const Framebuffer& window, Framebuffer& fb, uint32_t samples,
+                        const FeatureFilm* window_features, FeatureFilm* features) {
   // Under the mutex, as serve() adds the tiles other ranks return: one copy of a tile counts.
   const std::lock_guard lock(mutex_);
   if (in_[t]) return;
@@ -107,6 +108,7 @@ void TileServer::commit(uint32_t t, const Framebuffer& window, Framebuffer& fb, 
   for (int y = tile.y0; y < tile.y1; ++y) {
     for (int x = tile.x0; x < tile.x1; ++x) add_pixel(fb, x, y, window.sum(x, y), window.half_sum(x, y), samples);
   }
+  if (features && window_features) features->add_tile(*window_features, tile);
   received(t);
 }
 
@@ -123,7 +125,7 @@ void TileServer::check_overdue(std::chrono::steady_clock::time_point now) {
   }
 }
 
-void TileServer::serve(Framebuffer& fb, uint32_t samples) {
+void TileServer::serve(Framebuffer& fb, uint32_t samples, FeatureFilm* features) {
   std::vector<char> buffer, answer_bytes;
   Backoff backoff;
   using Clock = std::chrono::steady_clock;
@@ -215,7 +217,9 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
           const Tile& t = tiles_[size_t(first)];
           const size_t plane = size_t(t.pixel_count()) * 3 * sizeof(float);
           const bool halves = fb.has_halves();
-          if (size_t(bytes) != sizeof first + plane * (halves ? 2 : 1)) break;
+          const size_t feature_bytes =
+              features ? size_t(t.pixel_count()) * FeatureFilm::kPixelFloats * sizeof(float) : 0;
+          if (size_t(bytes) != sizeof first + plane * (halves ? 2 : 1) + feature_bytes) break;
           const char* p = buffer.data() + sizeof first;
           for (int y = t.y0; y < t.y1; ++y) {
             for (int x = t.x0; x < t.x1; ++x) {
@@ -225,6 +229,11 @@ void TileServer::serve(Framebuffer& fb, uint32_t samples) {
               p += sizeof c;
               add_pixel(fb, x, y, Vec3{c[0], c[1], c[2]}, Vec3{h[0], h[1], h[2]}, samples);
             }
+          }
+          if (features) {
+            FeatureFilm window(t);
+            std::memcpy(window.data(), buffer.data() + sizeof first + plane * (halves ? 2 : 1), feature_bytes);
+            features->add_tile(window, t);
           }
           received(uint32_t(first));
           break;
@@ -309,7 +318,7 @@ int32_t TileClient::Worker::wait_answer(double& idle_ms) {
 void TileClient::Worker::wait_send() { complete(result_send_); }
 
 std::optional<uint32_t> TileClient::Worker::next(std::optional<uint32_t> finished, const Framebuffer* sums,
-                                                 double& idle_ms) {
+                                                 const FeatureFilm* features, double& idle_ms) {
   if (!started_) {
     post_request();
     started_ = true;
@@ -328,6 +337,10 @@ std::optional<uint32_t> TileClient::Worker::next(std::optional<uint32_t> finishe
           result_.insert(result_.end(), reinterpret_cast<const char*>(c), reinterpret_cast<const char*>(c) + sizeof c);
         }
       }
+    }
+    if (features) {
+      const char* f = reinterpret_cast<const char*>(features->data());
+      result_.insert(result_.end(), f, f + features->float_count() * sizeof(float));
     }
     std::lock_guard lock(client_.mutex_);
     MPI_Isend(result_.data(), int(result_.size()), MPI_BYTE, 0, pass_tag(client_.serial_, kResult), MPI_COMM_WORLD,

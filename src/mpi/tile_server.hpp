@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "film/convergence.hpp"
+#include "film/feature_film.hpp"
 #include "film/framebuffer.hpp"
 #include "parallel/tiles.hpp"
 
@@ -72,12 +73,14 @@ class TileServer {
   std::optional<TileGrant> take();
   // One of rank 0's own fresh tiles is rendered.
   void own_done(uint32_t tile);
-  // Adds a reissued tile's sums (a window) unless another copy came first.
-  void commit(uint32_t tile, const Framebuffer& window, Framebuffer& fb, uint32_t samples);
+  // Adds a reissued tile's sums (a window, and with --denoise its features into `features`)
+  // unless another copy came first.
+  void commit(uint32_t tile, const Framebuffer& window, Framebuffer& fb, uint32_t samples,
+              const FeatureFilm* window_features = nullptr, FeatureFilm* features = nullptr);
   // Answers the other ranks' requests and adds the tiles they return into `fb` (as the sum of
-  // `samples` samples per pixel) until every tile is in and every rank still answering has said
-  // it is done. Throws RankFailed.
-  void serve(Framebuffer& fb, uint32_t samples);
+  // `samples` samples per pixel) and, with --denoise, their features into `features`, until
+  // every tile is in and every rank still answering has said it is done. Throws RankFailed.
+  void serve(Framebuffer& fb, uint32_t samples, FeatureFilm* features = nullptr);
   // Time spent handling messages (receiving, adding a tile, answering), and their number.
   double busy_ms() const { return busy_ms_; }
   uint64_t messages() const { return messages_; }
@@ -127,7 +130,8 @@ class TileClient {
     // The next tile to render, or nothing when the pass is over (then this thread is done and
     // has told rank 0). Sends `finished`'s sums first, if given. `idle_ms` gets the time spent
     // waiting for a tile.
-    std::optional<uint32_t> next(std::optional<uint32_t> finished, const Framebuffer* sums, double& idle_ms);
+    std::optional<uint32_t> next(std::optional<uint32_t> finished, const Framebuffer* sums, const FeatureFilm* features,
+                                 double& idle_ms);
     // With masks: the blocks of the tile next() returned (ActivePixels::window_blocks()).
     const uint8_t* mask() const { return reinterpret_cast<const uint8_t*>(answer_.data() + sizeof(int32_t)); }
 
