@@ -263,6 +263,36 @@ TEST_F(ViewServerTest, FinishedImageIsTheCopiedCommandsRender) {
   }
 }
 
+// Path tracing's image is denoised once the camera rests (the toggle on by default): the finished
+// frame is `tracer render --denoise`'s image, and the toggle off restarts to the noisy one.
+TEST_F(ViewServerTest, TheDenoiseToggleGivesTheCopiedCommandsImage) {
+  EXPECT_EQ(session_->state()["denoise"], true);
+  for (const bool denoise : {true, false}) {
+    SCOPED_TRACE(denoise);
+    const uint64_t before = session_->state()["generation"];
+    ASSERT_EQ(post(json{{"integrator", "path"}, {"spp", 1}, {"denoise", denoise}}.dump())->status, 200);
+    EXPECT_GT(session_->state()["generation"].get<uint64_t>(), before);
+    const auto frame = complete_frame();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->denoised, denoise);
+    const std::string command = session_->state()["command"];
+    EXPECT_EQ(command.find(" --denoise") != std::string::npos, denoise) << command;
+    const auto png = client().Get(with_token("/image.png").c_str());
+    ASSERT_EQ(png->status, 200);
+    std::ofstream(dir_ + "/view.png", std::ios::binary) << png->body;
+    const auto rendered = run_copied_command(dir_ + "/render.png");
+    ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
+    EXPECT_EQ(read_image(dir_ + "/view.png").rgb, read_image(dir_ + "/render.png").rgb);
+  }
+  // Another integrator renders without it and keeps the toggle; a wrong type changes nothing.
+  ASSERT_EQ(post(R"({"denoise": true, "integrator": "ao"})")->status, 200);
+  EXPECT_EQ(session_->state()["denoise"], true);
+  EXPECT_EQ(std::string(session_->state()["command"]).find("--denoise"), std::string::npos);
+  const auto bad = post(R"({"denoise": 1})");
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("denoise: expected true or false"), std::string::npos) << bad->body;
+}
+
 // A raised target goes on from the film (no preview, no pass again) and still ends on render's
 // image; a lowered one starts again.
 TEST_F(ViewServerTest, RaisingTheTargetGoesOnFromTheFilm) {

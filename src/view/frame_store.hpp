@@ -23,6 +23,7 @@ struct Frame {
   double pass_fraction = 0.0;                      // of the pass in progress, 0 at a pass boundary
   bool preview = false;                            // a reduced-resolution frame of a camera in motion
   bool complete = false;                           // spp == spp_target: nothing more will come for this state
+  bool denoised = false;                           // the film's samples so far, denoised (--denoise)
   double frame_ms = 0.0;                           // rendering time of the last pass (or of the preview)
   double msamples_per_s = 0.0, mrays_per_s = 0.0;  // over this state's accumulation so far
 };

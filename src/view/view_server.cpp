@@ -203,6 +203,7 @@ std::string frame_event(const Frame& f) {
                             {"pass_fraction", f.pass_fraction},
                             {"preview", f.preview},
                             {"complete", f.complete},
+                            {"denoised", f.denoised},
                             {"frame_ms", f.frame_ms},
                             {"msamples_per_s", f.msamples_per_s},
                             {"mrays_per_s", f.mrays_per_s},

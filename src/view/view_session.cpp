@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "base/errors.hpp"
+#include "denoise/nfor.hpp"
 #include "driver/render_options.hpp"
 #include "driver/scene_setup.hpp"
 #include "io/image_io.hpp"
@@ -72,6 +73,13 @@ Vec2 vec2_field(const std::string& key, const nlohmann::json& value) {
 
 bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
 
+// Whether a state's image is denoised: the toggle on (for path tracing) and the image within
+// kMaxDenoisedPixels, whose denoiser planes take 2.8 GB (docs/VIEW.md).
+constexpr int64_t kMaxDenoisedPixels = 2048 * 2048;
+bool denoised(const driver::RenderArgs& a) {
+  return a.denoise && int64_t(a.settings.width) * int64_t(a.settings.height) <= kMaxDenoisedPixels;
+}
+
 }  // namespace
 
 std::string shell_quote(const std::string& word) {
@@ -91,7 +99,7 @@ std::string render_command(const driver::RenderArgs& a, const std::vector<std::s
   std::string out = "tracer render";
   for (size_t i = 0; i < user_flags.size(); ++i) {
     const std::string& t = user_flags[i];
-    bool drop = false;
+    bool drop = t == "--denoise";  // a flag of no value: the toggle's, written below
     for (const std::string& flag : dropped) {
       if (t == flag) {
         drop = true;
@@ -122,6 +130,7 @@ std::string render_command(const driver::RenderArgs& a, const std::vector<std::s
   out += " --max-depth " + std::to_string(a.settings.max_depth) + " --exposure " + format_float(a.settings.exposure);
   if (a.noise_threshold) out += " --noise-threshold " + shortest(*a.noise_threshold);
   if (a.min_spp) out += " --min-spp " + std::to_string(*a.min_spp);
+  if (a.denoise) out += " --denoise";
   return out;
 }
 
@@ -134,7 +143,9 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
       viewer_flags_(std::move(viewer_flags)),
       args_(args),
       noise_threshold_(args.noise_threshold),
-      min_spp_(args.min_spp) {
+      min_spp_(args.min_spp),
+      denoiser_(sched_.kind, sched_.threads) {
+  args_.denoise = denoise_ && args_.integrator == name_of<Integrator>(kIntegratorNames, Integrator::Path);
   // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
   // and settings are then derived from those explicit flags, as the command's will be.
   const CameraSpec camera = driver::camera_for(scene_, args_);
@@ -145,8 +156,9 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
   std::string note;
   const RenderSettings settings = driver::settings_for(args_, scene_, note);
   args_.spp = settings.spp;
-  job_ = {generation_, driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note), false,
-          generation_};
+  job_ = {
+      generation_,    driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note), false, generation_,
+      denoised(args_)};
   exposure_ = settings.exposure;
 }
 
@@ -176,6 +188,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   {
     const std::lock_guard lock(mu_);
     driver::RenderArgs a = args_;
+    bool denoise = denoise_;
     for (const auto& [key, value] : change.items()) {
       if (key == "eye") {
         a.eye = vec_text(vec_field(key, value));
@@ -208,12 +221,19 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
         a.settings.width = int_field(key, value, 1, kMaxViewSide);
       } else if (key == "height") {
         a.settings.height = int_field(key, value, 1, kMaxViewSide);
+      } else if (key == "denoise") {
+        if (!value.is_boolean()) throw UsageError("denoise: expected true or false, got " + value.dump());
+        denoise = value.get<bool>();
       } else {
         throw UsageError("unknown field '" + key +
                          "' (eye, look, up, fov, aperture, focus_distance, focus_at, integrator, spp, max_depth, "
-                         "exposure, width, height)");
+                         "exposure, width, height, denoise)");
       }
     }
+    // The toggle is path tracing's: another integrator renders without it, and a switch back
+    // takes it again.
+    a.denoise = denoise &&
+                parse_name<Integrator>(kIntegratorNames, a.integrator, "integrator", "integrator") == Integrator::Path;
     // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
     // looking at its own position or along its up vector).
     driver::validate(a);
@@ -234,11 +254,13 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
                            a.aperture == args_.aperture && a.focus_distance == args_.focus_distance &&
                            a.integrator == args_.integrator && a.settings.max_depth == args_.settings.max_depth &&
                            a.settings.width == args_.settings.width && a.settings.height == args_.settings.height &&
+                           a.denoise == args_.denoise &&
                            // adaptive sampling measures noise at the exposure: another one stops other pixels
                            (!adaptive(settings) || settings.exposure == job_.settings.exposure);
     const bool restart = !same_view || a.spp != args_.spp;
     const bool raised = same_view && *a.spp > *args_.spp;
     args_ = a;
+    denoise_ = denoise;
     job_.settings.exposure = settings.exposure;
     if (restart) {
       const auto now = Clock::now();
@@ -246,7 +268,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
       const uint64_t film_base = same_view ? job_.film_base : generation_ + 1;
       // A raised target lets the pass in progress finish, to go on from it.
       if (!raised) interrupt_.store(true);
-      job_ = {++generation_, camera, settings, now - last_change_ < kMotionInterval, film_base};
+      job_ = {++generation_, camera, settings, now - last_change_ < kMotionInterval, film_base, denoised(a)};
       last_change_ = now;
     }
     result = state_locked();
@@ -298,6 +320,7 @@ nlohmann::json ViewSession::state_locked() const {
           {"exposure", args_.settings.exposure},
           {"width", args_.settings.width},
           {"height", args_.settings.height},
+          {"denoise", denoise_},
           {"max_side", kMaxViewSide},
           {"command", render_command(args_, user_flags_, viewer_flags_)},
           {"scene", scene_.source},
@@ -404,6 +427,11 @@ bool ViewSession::render_job(const Job& job) {
     }
     film_.emplace(s.width, s.height);
     if (adaptive(s)) film_->keep_halves();
+    if (job.denoise) {
+      features_.emplace(s.width, s.height);
+    } else {
+      features_.reset();
+    }
     film_done_ = 0;
   } else {
     const std::lock_guard lock(display_mu_);
@@ -413,6 +441,7 @@ bool ViewSession::render_job(const Job& job) {
   film_base_ = job.film_base;
   Framebuffer& fb = *film_;
   RenderContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
+  ctx.features = job.denoise ? &*features_ : nullptr;
   RenderControl control;
   const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
   const auto t_start = Clock::now();
@@ -420,10 +449,11 @@ bool ViewSession::render_job(const Job& job) {
   for (size_t p = first_pass; p < passes.size(); ++p) {
     ctx.samples = passes[p];
     tiles_done = 0;
-    // After the first pass, each finished tile refines the display at once; the first pass is
-    // shown whole (the preview stands in for it meanwhile).
+    // After the first pass, each finished tile refines the display at once (but for a denoised
+    // state, whose display changes only by whole denoised passes); the first pass is shown whole
+    // (the preview stands in for it meanwhile).
     control.on_tile = nullptr;
-    if (p > 0) {
+    if (p > 0 && !job.denoise) {
       control.on_tile = [&](const Tile& tile) {
         {
           const std::lock_guard lock(display_mu_);
@@ -455,17 +485,50 @@ bool ViewSession::render_job(const Job& job) {
         display_image_ = tonemap(fb, exposure_);
         display_generation_ = job.generation;
         display_target_ = uint32_t(s.spp);
+        display_denoised_ = false;
+        display_awaits_denoise_ = job.denoise;
       }
-      display_spp_ = film_done_;
+      if (!display_denoised_) display_spp_ = film_done_;
       pass_fraction_ = 0.0;
       last_pass_ms_ = pass_seconds * 1e3;
       accum_seconds_ = seconds_since(t_start);
       accum_samples_ = control.counts.load().primary;  // samples taken: adaptive sampling skips some pixels
       accum_rays_ = control.rays_done.load();
     }
-    publish_display(true);
+    if (p == 0 || !job.denoise) publish_display(true);
+    // The camera rests here: a move in progress would have interrupted the pass (or, in motion,
+    // the pause before the full image).
+    if (job.denoise && !denoise_display(job, p + 1 == passes.size())) return false;
   }
   if (first_pass == passes.size()) publish_display(true);  // the film already holds them all
+  return true;
+}
+
+bool ViewSession::denoise_display(const Job& job, bool last_pass) {
+  // At most a third of the time goes to denoising; the last pass's image always is.
+  if (!last_pass && display_denoised_ && seconds_since(denoised_at_) < 2e-3 * denoise_ms_) return true;
+  const auto t0 = Clock::now();
+  std::vector<Vec3> image;
+  try {
+    image = denoise::nfor(*features_, denoiser_, &interrupt_);  // a change stops it within a tile
+  } catch (const Cancelled&) {
+    return false;
+  }
+  denoise_ms_ = seconds_since(t0) * 1e3;
+  denoised_at_ = Clock::now();
+  {
+    const std::lock_guard lock(display_mu_);
+    if (display_generation_ != job.generation || !display_) return true;
+    const int w = display_->width();
+    for (int y = 0; y < display_->height(); ++y) {
+      for (int x = 0; x < w; ++x) display_->set(x, y, image[size_t(y) * size_t(w) + size_t(x)]);
+    }
+    display_image_ = tonemap(*display_, exposure_);
+    display_spp_ = film_done_;
+    display_denoised_ = true;
+    display_awaits_denoise_ = false;
+  }
+  publish_display(true);
   return true;
 }
 
@@ -486,7 +549,8 @@ void ViewSession::publish_display(bool force) {
     meta->spp = display_spp_;
     meta->spp_target = display_target_;
     meta->pass_fraction = pass_fraction_;
-    meta->complete = display_spp_ >= display_target_ && pass_fraction_ == 0.0;
+    meta->complete = display_spp_ >= display_target_ && pass_fraction_ == 0.0 && !display_awaits_denoise_;
+    meta->denoised = display_denoised_;
     meta->frame_ms = last_pass_ms_;
     if (accum_seconds_ > 0.0) {
       meta->msamples_per_s = double(accum_samples_) / accum_seconds_ * 1e-6;

@@ -21,7 +21,9 @@
 #include <vector>
 
 #include "driver/render_args.hpp"
+#include "film/feature_film.hpp"
 #include "film/tone_map.hpp"
+#include "parallel/executor.hpp"
 #include "view/frame_store.hpp"
 
 namespace tracer::view {
@@ -74,7 +76,8 @@ class ViewSession {
   void stop();
 
   // Applies a change: a JSON object of any of eye, look, up ([x, y, z]), fov, integrator, spp,
-  // max_depth, exposure, width, height. Throws UsageError naming the field for an unknown field,
+  // max_depth, exposure, width, height, denoise (true or false: path tracing's image denoised
+  // once the camera rests; on by default). Throws UsageError naming the field for an unknown field,
   // a wrong type or a bad value; then nothing changes. Returns the new state.
   nlohmann::json apply(const nlohmann::json& change);
   // The state: the fields above, "generation" (counts changes that restart the accumulation),
@@ -100,6 +103,7 @@ class ViewSession {
     bool in_motion = false;  // came soon after the change before it
     // The first state of a chain that changed only the samples per pixel: its film may go on.
     uint64_t film_base = 0;
+    bool denoise = false;  // path tracing with the toggle on
   };
   void render_loop();
   bool render_job(const Job& job);
@@ -107,6 +111,10 @@ class ViewSession {
   // (`skipped`); false if stopped or changed meanwhile.
   bool render_preview(const Job& job, bool& skipped);
   void measured_cost(Integrator integrator, double seconds, uint64_t samples);
+  // After a finished pass of a denoised state: denoises the film into the display when the pass
+  // is the last or the denoiser has been idle twice as long as it last took; false if a change
+  // interrupted it.
+  bool denoise_display(const Job& job, bool last_pass);
   // Encodes the display and publishes it (`force`: now, else at most every progress interval);
   // call without display_mu_ held.
   void publish_display(bool force);
@@ -130,6 +138,7 @@ class ViewSession {
   // without them and a switch back to path tracing takes them again.
   std::optional<double> noise_threshold_;
   std::optional<int> min_spp_;
+  bool denoise_ = true;  // the page's toggle; applies to path tracing only
   Job job_;
   uint64_t generation_ = 1;
   std::chrono::steady_clock::time_point last_change_{};
@@ -152,8 +161,14 @@ class ViewSession {
 
   // The render thread's film: the state chain it belongs to and the samples per pixel it holds.
   std::optional<Framebuffer> film_;
+  std::optional<FeatureFilm> features_;  // beside film_ for a denoised state
   uint64_t film_base_ = 0;
   uint32_t film_done_ = 0;
+  Executor denoiser_;
+  double denoise_ms_ = 0.0;  // the last denoising's time
+  std::chrono::steady_clock::time_point denoised_at_{};
+  bool display_denoised_ = false;        // the display holds a denoised image (guarded by display_mu_)
+  bool display_awaits_denoise_ = false;  // a denoised state's noisy first pass: not its final frame
 
   // Nanoseconds per pixel sample of each integrator, measured: sizes the preview.
   std::array<double, 3> ns_per_sample_{0.0, 0.0, 0.0};

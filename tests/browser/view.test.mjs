@@ -80,7 +80,7 @@ try {
   // Frames arrive; with a higher target the samples per pixel rise pass by pass, shown on the panel.
   await waitFor(() => window.tracerView.metrics.lastFrame?.complete === true);
   assert.equal((await lastFrame()).mime, 'image/png');
-  assert.match(await page.textContent('#spp'), /^16 \/ 16$/);
+  assert.match(await page.textContent('#spp'), /^16 \/ 16(, denoised)?$/);
   await page.fill('#spp-target', '4096');
   await page.press('#spp-target', 'Enter');
   await waitFor(() => {
@@ -93,7 +93,7 @@ try {
     return window.tracerView.metrics.log.filter((f) => f.generation === g && !f.preview).map((f) => f.spp);
   });
   assert.ok(rising.every((spp, i) => i === 0 || spp >= rising[i - 1]), `spp never falls: ${rising}`);
-  assert.match(await page.textContent('#spp'), /^\d+\+? \/ 4096$/);
+  assert.match(await page.textContent('#spp'), /^\d+\+? \/ 4096(, denoised)?$/);
   await page.fill('#spp-target', '16');
   await page.press('#spp-target', 'Enter');
   await waitFor(() => {
