@@ -256,3 +256,74 @@ TEST(Path, RmseFallsAsOneOverSqrtSpp) {
 
 }  // namespace
 }  // namespace tracer
+
+namespace tracer {
+namespace {
+
+// A floor under a large square lamp 0.3 above it: where the lamp fills most of a point's sky,
+// area sampling's 1/d^2 noise is largest.
+Scene big_lamp_scene() {
+  Scene s;
+  Material floor, lamp;
+  floor.kd = Vec3{0.7f};
+  lamp.kd = Vec3{0.0f};
+  lamp.ke = Vec3{4.0f};
+  s.materials = {floor, lamp};
+  s.add_mesh("floor", {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}}, {0, 3, 2, 0, 2, 1}, 0);
+  s.add_mesh("lamp", {{-0.8f, 0.3f, -0.8f}, {0.8f, 0.3f, -0.8f}, {0.8f, 0.3f, 0.8f}, {-0.8f, 0.3f, 0.8f}},
+             {0, 1, 2, 0, 2, 3}, 1);
+  s.finalize();
+  return s;
+}
+
+TEST(Path, EmittersBySolidAngleGiveAreaSamplingsImageWithLessNoise) {
+  const Scene by_angle = big_lamp_scene();
+  Scene by_area = by_angle;
+  by_area.emitters = Emitters(by_area, /*solid_angle=*/false);
+  const CameraSpec cam{{0.0f, 1.2f, 3.5f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 50.0f};
+  // Each way, two renders of other seeds: their mean, the variance of that mean (from each
+  // pixel's samples, taken as independent), and their squared difference (the error as it is).
+  double mean[2], var[2], difference[2];
+  for (int m = 0; m < 2; ++m) {
+    const Scene& scene = m == 0 ? by_angle : by_area;
+    const Accelerator accel = build_accelerator(scene, AccelOptions{});
+    RenderSettings s;
+    s.integrator = Integrator::Path;
+    s.width = s.height = 32;
+    s.spp = 64;
+    std::vector<Framebuffer> images;
+    mean[m] = var[m] = difference[m] = 0.0;
+    for (const uint32_t seed : {1u, 2u}) {
+      s.seed = seed;
+      Framebuffer fb(s.width, s.height);
+      FeatureFilm film(s.width, s.height);
+      RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+      ctx.features = &film;
+      RenderControl control;
+      ASSERT_TRUE(render_round(accel, ctx, sample_passes(s), SchedOptions{}, control));
+      for (int y = 0; y < s.height; ++y) {
+        for (int x = 0; x < s.width; ++x) {
+          mean[m] += double(fb.radiance(x, y).x);
+          var[m] += double(film.variance_of_mean(x, y).x);
+        }
+      }
+      images.push_back(std::move(fb));
+    }
+    for (int y = 0; y < s.height; ++y) {
+      for (int x = 0; x < s.width; ++x) {
+        const double d = double(images[0].radiance(x, y).x) - double(images[1].radiance(x, y).x);
+        difference[m] += d * d;
+      }
+    }
+    const double n = double(2 * s.width * s.height);
+    mean[m] /= n;
+    var[m] /= n * n;
+  }
+  // The same image within four standard errors, and the error between two renders a third
+  // (when written; in linear radiance, where the lamp's edge pixels, as noisy either way, count most).
+  EXPECT_NEAR(mean[0], mean[1], 4.0 * std::sqrt(var[0] + var[1])) << mean[0] << " " << mean[1];
+  EXPECT_LT(difference[0], 0.5 * difference[1]) << difference[0] << " " << difference[1];
+}
+
+}  // namespace
+}  // namespace tracer

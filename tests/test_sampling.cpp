@@ -3,12 +3,19 @@
 // to one).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <random>
 #include <vector>
 
+#include "math/sampling.hpp"
 #include "math/sobol.hpp"
+#include "math/spherical_triangle.hpp"
+#include "scene/emitters.hpp"
 #include "scene/environment_map.hpp"
+#include "scene/scene.hpp"
 
 namespace tracer {
 namespace {
@@ -176,6 +183,121 @@ TEST(EnvironmentMap, RadianceIsTheTexelTheDirectionFallsIn) {
   // Negative and non-finite texels read as black.
   const EnvironmentMap bad(2, 1, {Vec3{-1.0f, NAN, INFINITY}, Vec3{1.0f}});
   EXPECT_EQ(bad.radiance(Vec3{-1.0f, 0.0f, 0.01f}).x + bad.radiance(Vec3{-1.0f, 0.0f, 0.01f}).y, 0.0f);
+}
+
+}  // namespace
+}  // namespace tracer
+
+namespace tracer {
+namespace {
+
+// One emissive triangle, large and close above the origin, its front face down toward it.
+Scene one_emitter() {
+  Scene s;
+  Material lamp;
+  lamp.kd = Vec3{0.0f};
+  lamp.ke = Vec3{1.0f};
+  s.materials = {lamp};
+  s.add_mesh("lamp", {{-1.0f, 0.5f, -1.0f}, {1.2f, 0.5f, -1.0f}, {0.0f, 0.5f, 1.5f}}, {0, 1, 2}, 0);
+  s.finalize();
+  if (s.triangles[0].normal().y > 0.0f) {  // make the front face the origin
+    Scene flipped;
+    flipped.materials = s.materials;
+    flipped.add_mesh("lamp", {{-1.0f, 0.5f, -1.0f}, {1.2f, 0.5f, -1.0f}, {0.0f, 0.5f, 1.5f}}, {0, 2, 1}, 0);
+    flipped.finalize();
+    return flipped;
+  }
+  return s;
+}
+
+// Where the ray from `o` along `d` meets triangle `t` (Moller-Trumbore), if it does.
+std::optional<Vec3> hit_point(const Triangle& t, Vec3 o, Vec3 d) {
+  const Vec3 e1 = t.v1 - t.v0, e2 = t.v2 - t.v0, p = cross(d, e2);
+  const float det = dot(e1, p);
+  if (std::fabs(det) < 1e-12f) return std::nullopt;
+  const Vec3 s = o - t.v0;
+  const float u = dot(s, p) / det;
+  const Vec3 q = cross(s, e1);
+  const float v = dot(d, q) / det, dist = dot(e2, q) / det;
+  if (u < 0.0f || v < 0.0f || u + v > 1.0f || dist <= 0.0f) return std::nullopt;
+  return o + d * dist;
+}
+
+// Chi-square test of `sampled`'s directions from the origin against `judged`'s pdf over a
+// (theta, phi) grid of the upper hemisphere (theta from +y), as the BSDFs' test does; returns the
+// upper tail probability. `integral`: the judged pdf integrated over the hemisphere.
+double emitter_chi_square(const Scene& scene, const Emitters& sampled, const Emitters& judged, double& integral) {
+  constexpr int kTheta = 24, kPhi = 48, kSamples = 400000, kSub = 8;
+  const Frame frame(Vec3{0.0f, 1.0f, 0.0f});
+  std::vector<double> observed(kTheta * kPhi, 0.0), expected(kTheta * kPhi, 0.0);
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const auto cell = [&](Vec3 w) {
+    const Vec3 l = frame.to_local(w);
+    const double theta = std::acos(std::clamp(double(l.z), -1.0, 1.0));
+    double phi = std::atan2(double(l.y), double(l.x));
+    if (phi < 0) phi += 2.0 * std::numbers::pi;
+    return size_t(std::min(kTheta - 1, int(theta / (std::numbers::pi / 2) * kTheta)) * kPhi +
+                  std::min(kPhi - 1, int(phi / (2.0 * std::numbers::pi) * kPhi)));
+  };
+  for (int i = 0; i < kSamples; ++i) {
+    EmitterSample s;
+    if (sampled.sample(scene, Vec3{0.0f}, u(gen), u(gen), u(gen), s)) observed[cell(s.wi)] += 1.0;
+  }
+  const double dt = std::numbers::pi / 2 / kTheta, dp = 2.0 * std::numbers::pi / kPhi;
+  integral = 0.0;
+  for (int ti = 0; ti < kTheta; ++ti) {
+    for (int pi = 0; pi < kPhi; ++pi) {
+      double sum = 0.0;
+      for (int a = 0; a < kSub; ++a) {
+        for (int b = 0; b < kSub; ++b) {
+          const double theta = (ti + (a + 0.5) / kSub) * dt, phi = (pi + (b + 0.5) / kSub) * dp;
+          const Vec3 w = frame.to_world(Vec3{float(std::sin(theta) * std::cos(phi)),
+                                             float(std::sin(theta) * std::sin(phi)), float(std::cos(theta))});
+          if (const std::optional<Vec3> p = hit_point(scene.triangles[0], Vec3{0.0f}, w)) {
+            sum += double(judged.pdf(scene, 0, Vec3{0.0f}, *p)) * std::sin(theta);
+          }
+        }
+      }
+      expected[size_t(ti * kPhi + pi)] = sum * dt * dp / (kSub * kSub) * kSamples;
+      integral += sum * dt * dp / (kSub * kSub);
+    }
+  }
+  double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+  int cells = 0;
+  for (size_t i = 0; i < observed.size(); ++i) {
+    if (expected[i] < 5.0) {
+      pooled_obs += observed[i];
+      pooled_exp += expected[i];
+      continue;
+    }
+    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++cells;
+  }
+  if (pooled_exp > 0.0) {
+    chi2 += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
+    ++cells;
+  }
+  const double k = std::max(cells - 1, 1);
+  const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+TEST(EmitterSampling, SolidAngleSamplesFollowTheirPdfWhichIntegratesToOne) {
+  const Scene scene = one_emitter();
+  const double omega =
+      triangle_solid_angle(Vec3{0.0f}, scene.triangles[0].v0, scene.triangles[0].v1, scene.triangles[0].v2);
+  ASSERT_GT(omega, Emitters::kMinSolidAngle);  // a triangle sampled by solid angle from here
+  ASSERT_LT(omega, Emitters::kMaxSolidAngle);
+  const Emitters by_angle(scene, true), by_area(scene, false);
+  for (const Emitters* e : {&by_angle, &by_area}) {
+    double integral = 0.0;
+    EXPECT_GT(emitter_chi_square(scene, *e, *e, integral), 1e-4);
+    EXPECT_NEAR(integral, 1.0, 0.01);
+  }
+  // The test can fail: area samples judged by the solid-angle density.
+  double integral = 0.0;
+  EXPECT_LT(emitter_chi_square(scene, by_area, by_angle, integral), 1e-5);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // The emissive triangles as area lights for the path integrator: each with its true area and
-// normal, chosen in proportion to its power (luminance of Ke times area), a point on it uniformly
-// by area. Emission is one-sided, from the face the winding makes the front (counter-clockwise
-// seen from the lit side), as in pbrt and the measured Cornell box: a lamp mounted just below a
+// normal, chosen in proportion to its power (luminance of Ke times area), then a direction toward
+// it uniformly in the solid angle it subtends where that angle is large (math/spherical_triangle.hpp),
+// else a point on it uniformly by area. Emission is one-sided, from the face the winding makes the front
+// (counter-clockwise seen from the lit side), as in pbrt and the measured Cornell box: a lamp mounted just below a
 // ceiling must not light the gap above it.
 #pragma once
 
@@ -25,8 +26,9 @@ struct EmitterSample {
 class Emitters {
  public:
   Emitters() = default;
-  // Every non-degenerate triangle with an emissive material.
-  explicit Emitters(const Scene& scene);
+  // Every non-degenerate triangle with an emissive material. `solid_angle` false: every point by
+  // area (the estimator before solid-angle sampling, which tests compare against).
+  explicit Emitters(const Scene& scene, bool solid_angle = true);
   bool empty() const { return tris_.empty(); }
   size_t size() const { return tris_.size(); }
   // A point on an emitter seen from `from`, by three uniform numbers; false if it has no solid
@@ -37,7 +39,15 @@ class Emitters {
   float pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const;
   uint64_t memory_bytes() const { return tris_.capacity() * 4 * sizeof(float); }
 
+  // Solid angles within which a triangle is sampled by solid angle: below, its directions are
+  // nearly parallel and area sampling is as good (and the spherical angles lose precision);
+  // above, nearly a hemisphere, where the spherical triangle's arcs degenerate (pbrt-v4's bounds).
+  static constexpr double kMinSolidAngle = 3e-4, kMaxSolidAngle = 6.22;
+
  private:
+  // Whether triangle `tri` is sampled by solid angle from `from` (its solid angle there).
+  bool by_solid_angle(const Scene& scene, uint32_t tri, Vec3 from, double& omega) const;
+  bool solid_angle_ = true;
   std::vector<uint32_t> tris_;  // scene triangle indices, ascending
   std::vector<float> cdf_;      // cdf_[i]: the probability of choosing one of tris_[0..i]
   std::vector<float> pmf_;      // probability of choosing tris_[i]
