@@ -149,14 +149,15 @@ TEST_F(ViewServerTest, BadChangesAreRefusedWithAMessageAndChangeNothing) {
 
 TEST_F(ViewServerTest, ChangesRestartTheAccumulationExposureRetonesAoOnly) {
   const uint64_t generation = session_->state()["generation"];
-  auto r = post(R"({"eye": [0.5, 1.25, 3], "spp": 2})");
+  auto r = post(R"({"eye": [0.5, 1.25, 3], "spp": 2, "denoise": false})");
   ASSERT_EQ(r->status, 200) << r->body;
   json s = json::parse(r->body);
   EXPECT_EQ(s["generation"], generation + 1);
   EXPECT_EQ(s["eye"], json::array({0.5, 1.25, 3.0}));
   EXPECT_NE(std::string(s["command"]).find("--eye 0.5,1.25,3 "), std::string::npos) << s["command"];
   EXPECT_NE(std::string(s["command"]).find("--spp 2 "), std::string::npos) << s["command"];
-  // Path tracing with adaptive sampling (the default) measures noise at the exposure, so another
+  // Path tracing with adaptive sampling (the default without denoising) measures noise at the
+  // exposure, so another
   // exposure restarts the film (as `tracer render` with it would stop other pixels); ao's film is
   // only tone-mapped again.
   r = post(R"({"exposure": 3})");

@@ -106,7 +106,8 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--noise-threshold", a.noise_threshold,
                  "path: adaptive sampling: a 4x4 block of pixels stops taking samples once each pixel's noise "
                  "estimate is below this (0-1; default " +
-                     (std::ostringstream() << kDefaultNoiseThreshold).str() + "; 0 gives every pixel --spp samples)");
+                     (std::ostringstream() << kDefaultNoiseThreshold).str() +
+                     ", 0 with --denoise; 0 gives every pixel --spp samples)");
   app.add_option("--min-spp", a.min_spp,
                  "path: adaptive sampling: samples every pixel takes before it may stop (2-1048576; default " +
                      std::to_string(RenderSettings{}.min_spp) + ")");

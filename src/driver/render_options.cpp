@@ -16,7 +16,7 @@ RenderSettings settings_for(const RenderArgs& a) {
   if (a.checkpoint && !path) throw UsageError("--checkpoint: only for --integrator path");
   if (a.noise_threshold && !path) throw UsageError("--noise-threshold: only for --integrator path");
   if (a.min_spp && !path) throw UsageError("--min-spp: only for --integrator path");
-  s.noise_threshold = path ? float(a.noise_threshold.value_or(kDefaultNoiseThreshold)) : 0.0f;
+  s.noise_threshold = path ? float(a.noise_threshold.value_or(a.denoise ? 0.0 : kDefaultNoiseThreshold)) : 0.0f;
   s.min_spp = a.min_spp.value_or(s.min_spp);
   for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--env-map", !a.scene.env_map.empty()}}) {
     if (given && s.integrator == Integrator::Ao)
