@@ -29,6 +29,16 @@ path_scene_flags() {
     *) echo "unknown scene $1" >&2; return 2 ;;
   esac
 }
+# sponza_without_bumps DIR SHARED: a copy of Sponza's folder in DIR/sponza (links to its files)
+# whose MTL has no bump maps, as the benchmarks beside Cycles render it (benchmarks-cycles.sh says
+# why); prints the OBJ's path.
+sponza_without_bumps() {
+  mkdir -p "$1/sponza"
+  ln -sf "$2/scenes/sponza/"* "$1/sponza/"
+  rm "$1/sponza/sponza.mtl"
+  grep -v -E '^\s*(map_bump|bump)\s' "$2/scenes/sponza/sponza.mtl" >"$1/sponza/sponza.mtl"
+  echo "$1/sponza/sponza.obj"
+}
 # seconds_to_rmse TARGET...: from rows "label seconds - rmse" on stdin (renders in order of falling
 # error), the seconds to reach each target RMSE, interpolated in log-log between the two renders
 # that bracket it; "<s" when the first render is already below, "-" when none reaches it.

@@ -49,12 +49,8 @@ scene_of() {
         "$shared/scenes/views.tsv" ;;
     sponza-sky)
       # A copy of the folder (links to its textures) whose MTL has no bump maps: see above.
-      mkdir -p "$work/sponza"
-      ln -sf "$shared/scenes/sponza/"* "$work/sponza/"
-      rm "$work/sponza/sponza.mtl"
-      grep -v -E '^\s*(map_bump|bump)\s' "$shared/scenes/sponza/sponza.mtl" >"$work/sponza/sponza.mtl"
-      awk -F'\t' -v w="$work" '$1 == "sponza" { print w "/sponza/sponza.obj", $3, $4, $5, $6, "1,1,1" }' \
-        "$shared/scenes/views.tsv" ;;
+      obj=$(sponza_without_bumps "$work" "$shared")
+      awk -F'\t' -v o="$obj" '$1 == "sponza" { print o, $3, $4, $5, $6, "1,1,1" }' "$shared/scenes/views.tsv" ;;
     *) echo "unknown scene $1" >&2; return 2 ;;
   esac
 }

@@ -28,11 +28,8 @@ scene_flags() {
   case $1 in
     cornell-original | cornell-water) path_scene_flags "$1" ;;
     sponza-sky)
-      mkdir -p "$work/sponza"
-      ln -sf "$shared/scenes/sponza/"* "$work/sponza/"
-      rm "$work/sponza/sponza.mtl"
-      grep -v -E '^\s*(map_bump|bump)\s' "$shared/scenes/sponza/sponza.mtl" >"$work/sponza/sponza.mtl"
-      awk -F'\t' -v w="$work" '$1 == "sponza" { print w "/sponza/sponza.obj", "--eye", $3, "--look", $4, "--up", $5, "--fov", $6 }' \
+      obj=$(sponza_without_bumps "$work" "$shared")
+      awk -F'\t' -v o="$obj" '$1 == "sponza" { print o, "--eye", $3, "--look", $4, "--up", $5, "--fov", $6 }' \
         "$shared/scenes/views.tsv"
       echo --env 1,1,1 ;;
     *) echo "unknown scene $1" >&2; return 2 ;;

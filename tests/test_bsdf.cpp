@@ -11,6 +11,7 @@
 
 #include "shade/bsdf.hpp"
 #include "shade/material_bsdf.hpp"
+#include "test_util.hpp"
 
 namespace tracer {
 namespace {
@@ -149,24 +150,7 @@ double chi_square_upper_tail(const Bsdf& sampled, const Bsdf& judged, Vec3 wo, c
       expected[size_t(ti * kPhi + pi)] = sum * dt * dp / (kSub * kSub) * kSamples;
     }
   }
-  double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
-  int cells = 0;
-  for (size_t i = 0; i < observed.size(); ++i) {
-    if (expected[i] < 5.0) {
-      pooled_obs += observed[i];
-      pooled_exp += expected[i];
-      continue;
-    }
-    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++cells;
-  }
-  if (pooled_exp > 0.0) {
-    chi2 += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
-    ++cells;
-  }
-  const double k = std::max(cells - 1, 1);
-  const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
+  return test::chi_square_tail(observed, expected);
 }
 
 TEST(Bsdf, ChiSquareSamplesFollowThePdf) {

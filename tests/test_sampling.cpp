@@ -16,6 +16,7 @@
 #include "scene/emitters.hpp"
 #include "scene/environment_map.hpp"
 #include "scene/scene.hpp"
+#include "test_util.hpp"
 
 namespace tracer {
 namespace {
@@ -263,24 +264,7 @@ double emitter_chi_square(const Scene& scene, const Emitters& sampled, const Emi
       integral += sum * dt * dp / (kSub * kSub);
     }
   }
-  double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
-  int cells = 0;
-  for (size_t i = 0; i < observed.size(); ++i) {
-    if (expected[i] < 5.0) {
-      pooled_obs += observed[i];
-      pooled_exp += expected[i];
-      continue;
-    }
-    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++cells;
-  }
-  if (pooled_exp > 0.0) {
-    chi2 += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
-    ++cells;
-  }
-  const double k = std::max(cells - 1, 1);
-  const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
+  return test::chi_square_tail(observed, expected);
 }
 
 TEST(EmitterSampling, SolidAngleSamplesFollowTheirPdfWhichIntegratesToOne) {

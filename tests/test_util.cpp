@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -90,6 +91,27 @@ std::string temp_dir() {
   std::string tmpl = (std::filesystem::temp_directory_path() / "tracer-test-XXXXXX").string();
   if (!::mkdtemp(tmpl.data())) std::abort();
   return tmpl;
+}
+
+double chi_square_tail(const std::vector<double>& observed, const std::vector<double>& expected) {
+  double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+  int cells = 0;
+  for (size_t i = 0; i < observed.size(); ++i) {
+    if (expected[i] < 5.0) {
+      pooled_obs += observed[i];
+      pooled_exp += expected[i];
+      continue;
+    }
+    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++cells;
+  }
+  if (pooled_exp > 0.0) {
+    chi2 += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
+    ++cells;
+  }
+  const double k = std::max(cells - 1, 1);
+  const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
 }  // namespace tracer::test

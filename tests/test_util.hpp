@@ -43,6 +43,11 @@ Scene scene_of(const std::vector<Triangle>& tris);
 
 double psnr(const Image8& a, const Image8& b);
 
+// The upper tail probability of Pearson's chi-square statistic of `observed` counts against
+// `expected` ones (cells expecting fewer than 5 pooled into one), by Wilson and Hilferty's normal
+// approximation: small when the counts do not follow the expectation.
+double chi_square_tail(const std::vector<double>& observed, const std::vector<double>& expected);
+
 // A fresh temporary directory for one test.
 std::string temp_dir();
 // Every byte of a file (images compared byte for byte).
