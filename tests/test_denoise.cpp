@@ -80,6 +80,7 @@ TEST(Denoise, ThirdOfTheNoiseAndTheSameMeanAsAConvergedReference) {
   // The reference's own error (1024 spp) is an eighth of the 16-spp image's. At 128x128 the box's
   // walls are a few dozen pixels: smaller images leave the denoiser too few neighbours of the same
   // surface (at 64x64 its mean was 1.5 % low, docs/DENOISING.md).
+  if (test::kUnderSanitizer) GTEST_SKIP() << "the reference takes minutes under a sanitizer; the release run checks it";
   const int size = 128;
   const Films reference = render_box(size, 1024);
   const Films noisy = render_box(size, 16);

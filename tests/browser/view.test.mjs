@@ -77,10 +77,21 @@ try {
     return viewState();
   };
 
-  // Frames arrive; with a higher target the samples per pixel rise pass by pass, shown on the panel.
+  // Frames arrive, path tracing's denoised once the view rests (the toggle on by default).
   await waitFor(() => window.tracerView.metrics.lastFrame?.complete === true);
   assert.equal((await lastFrame()).mime, 'image/png');
-  assert.match(await page.textContent('#spp'), /^16 \/ 16(, denoised)?$/);
+  assert.equal((await lastFrame()).denoised, true);
+  assert.ok(await page.isChecked('#denoise'));
+  assert.match(await page.textContent('#spp'), /^16 \/ 16, denoised$/);
+  // The toggle off: the accumulation starts again, noisy and refined tile by tile; with a higher
+  // target the samples per pixel rise pass by pass, shown on the panel.
+  await page.uncheck('#denoise');
+  await waitFor(() => {
+    const v = window.tracerView;
+    return !v.state().denoise && v.metrics.lastFrame?.generation === v.state().generation && v.metrics.lastFrame.complete;
+  });
+  assert.equal((await lastFrame()).denoised, false);
+  assert.match(await page.textContent('#spp'), /^16 \/ 16$/);
   await page.fill('#spp-target', '4096');
   await page.press('#spp-target', 'Enter');
   await waitFor(() => {
@@ -93,7 +104,7 @@ try {
     return window.tracerView.metrics.log.filter((f) => f.generation === g && !f.preview).map((f) => f.spp);
   });
   assert.ok(rising.every((spp, i) => i === 0 || spp >= rising[i - 1]), `spp never falls: ${rising}`);
-  assert.match(await page.textContent('#spp'), /^\d+\+? \/ 4096(, denoised)?$/);
+  assert.match(await page.textContent('#spp'), /^\d+\+? \/ 4096$/);
   await page.fill('#spp-target', '16');
   await page.press('#spp-target', 'Enter');
   await waitFor(() => {
