@@ -262,8 +262,6 @@ void RegressionRowT(const RegressionRow& a) {
   }
 }
 
-const char* KernelTarget() { return hwy::TargetName(HWY_TARGET); }
-
 }  // namespace HWY_NAMESPACE
 }  // namespace tracer::denoise
 HWY_AFTER_NAMESPACE();
@@ -274,7 +272,6 @@ namespace tracer::denoise {
 HWY_EXPORT(PatchDistances);
 HWY_EXPORT(FilterStepT);
 HWY_EXPORT(RegressionRowT);
-HWY_EXPORT(KernelTarget);
 
 void patch_distances(const PatchDistance& a) { HWY_DYNAMIC_DISPATCH(PatchDistances)(a); }
 void filter_step(const FilterStep& a) { HWY_DYNAMIC_DISPATCH(FilterStepT)(a); }
@@ -283,7 +280,6 @@ size_t regression_scratch_floats(int radius) {
   const size_t widest = 16, offsets = size_t(2 * radius + 1) * size_t(2 * radius + 1);
   return widest * (2 * offsets + size_t(2 * kRegressionEntries) + size_t(kDim * kDim));
 }
-const char* kernel_target() { return HWY_DYNAMIC_DISPATCH(KernelTarget)(); }
 
 }  // namespace tracer::denoise
 #endif  // HWY_ONCE

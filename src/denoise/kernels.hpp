@@ -67,7 +67,4 @@ struct RegressionRow {
 void regression_row(const RegressionRow& a);
 size_t regression_scratch_floats(int radius);
 
-// The name of the SIMD target the kernels run on.
-const char* kernel_target();
-
 }  // namespace tracer::denoise
