@@ -48,6 +48,23 @@ struct Context {
   CancelFlag cancel;
 };
 
+// f(x, y) for every pixel of a width x height image, bands of kTileHeight rows on the executor;
+// throws Cancelled once cancelled.
+template <class F>
+void for_pixels(const Context& cx, int width, int height, F&& f) {
+  const int bands = (height + kTileHeight - 1) / kTileHeight;
+  const bool done = cx.executor.for_each(
+      size_t(bands),
+      [&](size_t band) {
+        const int y0 = int(band) * kTileHeight;
+        for (int y = y0; y < std::min(y0 + kTileHeight, height); ++y) {
+          for (int x = 0; x < width; ++x) f(x, y);
+        }
+      },
+      cx.cancel);
+  if (!done) throw Cancelled();
+}
+
 // NL-means: each channel of `image` averaged over the window of `radius`, weighted by the patch
 // distances of `guide` (whose variance is `variance`) at bandwidth k.
 Planes nl_means(const Context& cx, const Planes& image, const Planes& guide, const Planes& variance, int patch,
@@ -109,21 +126,14 @@ std::vector<Planes> regress(const Context& cx, const Planes& image, const Planes
   return out;
 }
 
-template <class F>
-void for_pixels(int width, int height, F&& f) {
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) f(x, y);
-  }
-}
-
 float square(float x) { return x * x; }
 
 // Each channel averaged over the 3x3 pixels around (those inside the image): a variance
 // estimated from one difference per pixel, made steadier.
-Planes box3(const Planes& in) {
+Planes box3(const Context& cx, const Planes& in) {
   const int w = in.width(), h = in.height();
   Planes out(w, h, in.channels());
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < in.channels(); ++c) {
       float sum = 0.0f;
       int n = 0;
@@ -147,7 +157,7 @@ struct Halves {
   Planes feature_variance;  // of one half's mean, from the halves' difference, 3x3-averaged
 };
 
-Halves halves_of(const FeatureFilm& film) {
+Halves halves_of(const Context& cx, const FeatureFilm& film) {
   using F = FeatureFilm;
   const int w = film.width(), h = film.height();
   Halves hv;
@@ -156,9 +166,10 @@ Halves halves_of(const FeatureFilm& film) {
     hv.variance[size_t(s)] = Planes(w, h, 3);
     hv.features[size_t(s)] = Planes(w, h, kFeatures);
   }
-  double distance_sum = 0.0;
-  uint64_t distance_count = 0;
-  for_pixels(w, h, [&](int x, int y) {
+  // Per row, summed in row order afterwards: the same scale whatever the threads.
+  std::vector<double> distance_sum(size_t(h), 0.0);
+  std::vector<uint64_t> distance_count(size_t(h), 0);
+  for_pixels(cx, w, h, [&](int x, int y) {
     const float n[2] = {film.get(x, y, 0, F::kCount), film.get(x, y, 1, F::kCount)};
     for (int s = 0; s < 2; ++s) {
       // A half without samples (one sample per pixel) takes the other's.
@@ -187,19 +198,25 @@ Halves halves_of(const FeatureFilm& film) {
     }
     const float d = 0.5f * (hv.features[0](6, x, y) + hv.features[1](6, x, y));
     if (d > 0.0f && std::isfinite(d)) {
-      distance_sum += double(d);
-      ++distance_count;
+      distance_sum[size_t(y)] += double(d);
+      ++distance_count[size_t(y)];
     }
   });
-  const float scale = distance_count > 0 && distance_sum > 0.0 ? float(double(distance_count) / distance_sum) : 1.0f;
+  double sum = 0.0;
+  uint64_t count = 0;
+  for (int y = 0; y < h; ++y) {
+    sum += distance_sum[size_t(y)];
+    count += distance_count[size_t(y)];
+  }
+  const float scale = count > 0 && sum > 0.0 ? float(double(count) / sum) : 1.0f;
   Planes difference(w, h, kFeatures);
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int s = 0; s < 2; ++s) hv.features[size_t(s)](6, x, y) *= scale;
     for (int c = 0; c < kFeatures; ++c) {
       difference(c, x, y) = square(hv.features[0](c, x, y) - hv.features[1](c, x, y)) * 0.5f;
     }
   });
-  hv.feature_variance = box3(difference);
+  hv.feature_variance = box3(cx, difference);
   return hv;
 }
 
@@ -212,10 +229,10 @@ Halves halves_of(const FeatureFilm& film) {
 struct Guide {
   Planes colour, variance;
 };
-Guide demodulated(const Planes& colour, const Planes& variance, const Planes& features) {
+Guide demodulated(const Context& cx, const Planes& colour, const Planes& variance, const Planes& features) {
   const int w = colour.width(), h = colour.height();
   Guide g{Planes(w, h, 3), Planes(w, h, 3)};
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < 3; ++c) {
       const float inv = 1.0f / (std::max(features(c, x, y), 0.0f) + 0.02f);
       g.colour(c, x, y) = colour(c, x, y) * inv;
@@ -230,9 +247,9 @@ Guide demodulated(const Planes& colour, const Planes& variance, const Planes& fe
 std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, CancelFlag cancel, const NforOptions& o) {
   const int w = film.width(), h = film.height();
   Planes valid(w, h, 1);
-  for_pixels(w, h, [&](int x, int y) { valid(0, x, y) = 1.0f; });
   const Context cx{valid, executor, cancel};
-  Halves hv = halves_of(film);
+  for_pixels(cx, w, h, [&](int x, int y) { valid(0, x, y) = 1.0f; });
+  Halves hv = halves_of(cx, film);
 
   // 5.1: each half's features filtered with weights from the other's.
   constexpr float kFeatureK = 0.5f;
@@ -242,23 +259,23 @@ std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, Cancel
       nl_means(cx, hv.features[1], hv.features[0], hv.feature_variance, o.feature_patch, o.feature_radius, kFeatureK);
 
   Planes features(w, h, kFeatures);  // both halves
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < kFeatures; ++c) features(c, x, y) = 0.5f * (features_a(c, x, y) + features_b(c, x, y));
   });
 
   // 5.2: each half regressed on the other's features, weighted by the other's colour.
   constexpr float kBandwidths[2] = {0.5f, 1.0f};
-  const Guide guide_b = demodulated(hv.colour[1], hv.variance[1], features_b);
+  const Guide guide_b = demodulated(cx, hv.colour[1], hv.variance[1], features_b);
   const std::vector<Planes> est_a =
       regress(cx, hv.colour[0], guide_b.colour, guide_b.variance, features_b, o.patch, o.radius, kBandwidths);
-  const Guide guide_a = demodulated(hv.colour[0], hv.variance[0], features_a);
+  const Guide guide_a = demodulated(cx, hv.colour[0], hv.variance[0], features_a);
   const std::vector<Planes> est_b =
       regress(cx, hv.colour[1], guide_a.colour, guide_a.variance, features_a, o.patch, o.radius, kBandwidths);
 
   // 5.3: each bandwidth's error, estimated from the halves (each half's estimate against the
   // other half's colour, less that colour's variance and the estimates' own residual variance).
   Planes full(w, h, 3), full_variance(w, h, 3), error(w, h, 6);
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < 3; ++c) {
       const float ca = hv.colour[0](c, x, y), cb = hv.colour[1](c, x, y);
       const float va = hv.variance[0](c, x, y), vb = hv.variance[1](c, x, y);
@@ -271,18 +288,18 @@ std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, Cancel
       }
     }
   });
-  const Guide guide_full = demodulated(full, full_variance, features);
+  const Guide guide_full = demodulated(cx, full, full_variance, features);
   const Planes smooth_error =
       nl_means(cx, error, guide_full.colour, guide_full.variance, o.error_patch, o.error_radius, 1.0f);
   Planes choice(w, h, 3);
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < 3; ++c) choice(c, x, y) = smooth_error(c, x, y) < smooth_error(3 + c, x, y) ? 0.0f : 1.0f;
   });
   const Planes smooth_choice =
       nl_means(cx, choice, guide_full.colour, guide_full.variance, o.error_patch, o.error_radius, 1.0f);
 
   Planes combined(w, h, 3), combined_variance(w, h, 3);
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     for (int c = 0; c < 3; ++c) {
       const float t = smooth_choice(c, x, y);
       const float ra = est_a[0](c, x, y) + t * (est_a[1](c, x, y) - est_a[0](c, x, y));
@@ -296,12 +313,12 @@ std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, Cancel
   // halves' difference, 3x3-averaged, and the screen position left out of the regressors (both
   // lowered the Cornell box's error at 4 and 16 spp, docs/DENOISING.md).
   const float kFinal[1] = {1.0f};
-  const Guide guide_combined = demodulated(combined, box3(combined_variance), features);
+  const Guide guide_combined = demodulated(cx, combined, box3(cx, combined_variance), features);
   const Planes result = o.second_pass ? std::move(regress(cx, combined, guide_combined.colour, guide_combined.variance,
                                                           features, o.patch, o.radius, kFinal, false)[0])
                                       : std::move(combined);
   std::vector<Vec3> out(size_t(w) * size_t(h));
-  for_pixels(w, h, [&](int x, int y) {
+  for_pixels(cx, w, h, [&](int x, int y) {
     out[size_t(y) * size_t(w) + size_t(x)] = Vec3{result(0, x, y), result(1, x, y), result(2, x, y)};
   });
   return out;
