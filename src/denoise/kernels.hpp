@@ -57,7 +57,7 @@ struct RegressionRow {
   const Planes* features;  // kFeatures channels
   const Planes* valid;
   int x0, y0, ty, radius;
-  float position_scale;    // 1 / radius, or 0 to leave the position out of the regressors
+  float position_scale;    // 1 / radius, or 0 to leave the position out (kDim - 2 unknowns)
   const float* distances;  // the tile's: kTilePixels per offset, offsets row-major from (-r, -r)
   int bandwidths;
   float inv_k2[2];
