@@ -410,6 +410,20 @@ TEST(LargeArrays, AlignedWritableAndGrowable) {
     for (size_t i = 0; i < bytes; ++i) wrong += b[i] != static_cast<unsigned char>(i * 7) ? 1 : 0;
     EXPECT_EQ(wrong, 0u);
   }
+  // Zero-filled buffers read as zero even where the memory was used and freed before (small ones
+  // come from the heap, large ones from a fresh mapping), and are as aligned.
+  for (int round = 0; round < 2; ++round) {
+    for (const size_t bytes : {size_t(100), kHugeArrayMinBytes - 1, kHugeArrayMinBytes, size_t(9) << 20}) {
+      SCOPED_TRACE(bytes);
+      LargeBuffer<unsigned char> z(bytes, kZeroFilled);
+      const auto at = reinterpret_cast<uintptr_t>(z.get());
+      EXPECT_EQ(at % (bytes >= kHugeArrayMinBytes ? kHugePageBytes : 64), 0u);
+      size_t nonzero = 0;
+      for (size_t i = 0; i < bytes; ++i) nonzero += z[i] != 0 ? 1 : 0;
+      EXPECT_EQ(nonzero, 0u);
+      for (size_t i = 0; i < bytes; ++i) z[i] = 0xab;  // dirty, for the next round to reuse
+    }
+  }
   std::vector<uint32_t, LargeArrayAllocator<uint32_t>> v;
   for (uint32_t i = 0; i < 3'000'000; ++i) v.push_back(i);  // crosses into mappings and grows within them
   size_t wrong = 0;

@@ -21,6 +21,11 @@ inline constexpr size_t kHugeArrayMinBytes = size_t(1) << 20;
 // Throws std::bad_alloc. Free with free_large(p, bytes), the same `bytes`.
 void* allocate_large(size_t bytes);
 void free_large(void* p, size_t bytes) noexcept;
+// The same, zero-filled: from kHugeArrayMinBytes a fresh mapping, whose pages come zeroed from the
+// kernel when first touched -- by whichever thread writes them first, not all by the caller.
+// Free with free_large_zeroed(p, bytes).
+void* allocate_large_zeroed(size_t bytes);
+void free_large_zeroed(void* p, size_t bytes) noexcept;
 
 // A std::allocator on allocate_large: cache-line aligned, on huge pages when large.
 template <class T>
@@ -59,7 +64,10 @@ struct LargeArrayAllocator : HugePageAllocator<T> {
 template <class T>
 using LargeVector = std::vector<T, HugePageAllocator<T>>;
 
-// A fixed-size array of T from allocate_large, left uninitialised.
+struct ZeroFilled {};
+inline constexpr ZeroFilled kZeroFilled{};
+
+// A fixed-size array of T from allocate_large, left uninitialised (or zero-filled, when asked).
 template <class T>
 class LargeBuffer {
  public:
@@ -67,14 +75,24 @@ class LargeBuffer {
   explicit LargeBuffer(size_t n) : n_(n), p_(static_cast<T*>(allocate_large(n * sizeof(T)))) {
     static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
   }
-  LargeBuffer(LargeBuffer&& o) noexcept : n_(std::exchange(o.n_, 0)), p_(std::exchange(o.p_, nullptr)) {}
+  LargeBuffer(size_t n, ZeroFilled) : n_(n), zeroed_(true), p_(static_cast<T*>(allocate_large_zeroed(n * sizeof(T)))) {
+    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  }
+  LargeBuffer(LargeBuffer&& o) noexcept
+      : n_(std::exchange(o.n_, 0)), zeroed_(o.zeroed_), p_(std::exchange(o.p_, nullptr)) {}
   LargeBuffer& operator=(LargeBuffer&& o) noexcept {
     std::swap(n_, o.n_);
+    std::swap(zeroed_, o.zeroed_);
     std::swap(p_, o.p_);
     return *this;
   }
   ~LargeBuffer() {
-    if (p_) free_large(p_, n_ * sizeof(T));
+    if (!p_) return;
+    if (zeroed_) {
+      free_large_zeroed(p_, n_ * sizeof(T));
+    } else {
+      free_large(p_, n_ * sizeof(T));
+    }
   }
   T* get() const { return p_; }
   T& operator[](size_t i) const { return p_[i]; }
@@ -82,6 +100,7 @@ class LargeBuffer {
 
  private:
   size_t n_ = 0;
+  bool zeroed_ = false;
   T* p_ = nullptr;
 };
 

@@ -5,12 +5,8 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <cstdlib>
-#include <memory>
-#include <new>
 
-#include <sys/mman.h>
-#include <cstdint>
+#include "base/huge_pages.hpp"
 
 namespace tracer::denoise {
 
@@ -36,7 +32,7 @@ class Planes {
         stride_(ptrdiff_t(round_up(width, kTileWidth) + 2 * kBorder + kPatchColumns)),
         rows_(round_up(height, kTileHeight) + 2 * kBorder),
         size_(size_t(channels) * size_t(stride_) * size_t(rows_)),
-        data_(zeroed(size_)) {}
+        data_(size_, kZeroFilled) {}
   Planes(Planes&&) noexcept = default;
   Planes& operator=(Planes&&) noexcept = default;
   Planes(const Planes& o) : Planes(o.width_, o.height_, o.channels_) {
@@ -64,22 +60,10 @@ class Planes {
   ptrdiff_t stride_ = 0;
   int rows_ = 0;
   size_t size_ = 0;
-  // calloc: a large block comes zeroed from the kernel, its pages touched first by whichever
-  // thread writes them, not zeroed here by one thread (a megapixel's planes are 660 MB, whose
-  // zeroing and page faults took a tenth of the denoiser's time when done up front).
-  struct Free {
-    void operator()(float* p) const { std::free(p); }
-  };
-  std::unique_ptr<float[], Free> data_;
-  static float* zeroed(size_t n) {
-    if (n == 0) return nullptr;
-    auto* p = static_cast<float*>(std::calloc(n, sizeof(float)));
-    if (p == nullptr) throw std::bad_alloc();
-    const uintptr_t huge = uintptr_t(2) << 20, begin = (reinterpret_cast<uintptr_t>(p) + huge - 1) & ~(huge - 1),
-                    end = (reinterpret_cast<uintptr_t>(p + n)) & ~(huge - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-    return p;
-  }
+  // Zero-filled by the kernel as its pages are first touched, by the threads that write them: a
+  // megapixel's planes are 660 MB, whose zeroing and page faults on the calling thread took a
+  // tenth of the denoiser's time.
+  LargeBuffer<float> data_;
 };
 
 }  // namespace tracer::denoise
