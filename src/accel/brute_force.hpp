@@ -1,8 +1,10 @@
-// The study's O(N) baseline: every ray against every triangle.
+// The study's O(N) baselines: every ray against every triangle, one at a time (BruteForce) or
+// eight at a time (SimdBruteForce).
 #pragma once
 
 #include <vector>
 
+#include "accel/kernels/triangle_pack.hpp"
 #include "accel/kernels/triangle_test.hpp"
 #include "scene/scene.hpp"
 
@@ -41,6 +43,22 @@ class BruteForce {
   const Scene* scene_;
   std::vector<Triangle> tris_;
   std::vector<uint32_t> ids_;
+};
+
+// The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight
+// at a time, through the same pack kernel as the wide BVH's leaves.
+class SimdBruteForce {
+ public:
+  explicit SimdBruteForce(const Scene& scene);
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+  const std::vector<TrianglePack>& packs() const { return packs_; }
+  const Scene& scene() const { return *scene_; }
+  size_t memory_bytes() const { return packs_.size() * sizeof(TrianglePack); }
+
+ private:
+  const Scene* scene_;
+  std::vector<TrianglePack> packs_;
 };
 
 }  // namespace tracer

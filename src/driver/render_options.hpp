@@ -12,8 +12,8 @@ RenderSettings settings_for(const RenderArgs& args);
 inline constexpr int kDefaultPathSpp = 64;
 // Adaptive sampling's noise threshold when --noise-threshold is not given (docs/BENCHMARKS.md,
 // adaptive sampling: how it was chosen); the library's default is off, and so is --denoise's
-// (BENCHMARKS.md section 21: with the denoiser it saved no time and lowered a caustic's mean by
-// 2 %). --min-spp's default is RenderSettings'.
+// (BENCHMARKS.md section 21: with the denoiser it saved no time and lowered a caustic's mean). --min-spp's default is
+// RenderSettings'.
 inline constexpr double kDefaultNoiseThreshold = 0.01;
 // settings_for() plus what depends on the scene: a path render of a scene with no emissive
 // surface and no --env is lit by a uniform white sky as well as any point lights (a point light

@@ -6,7 +6,7 @@
 // values of a colour, nan, inf, values out of range. Tokens are separated by any run of spaces and
 // tabs; `#` starts a comment anywhere on a line (exporters glue them to numbers). Where tracer
 // reads a file otherwise than tinyobjloader, docs/RELIABILITY.md says why (the differential test
-// in tests/test_mtl_differential.cpp holds the rest equal).
+// in tests/test_mtl.cpp holds the rest equal).
 #pragma once
 
 #include <string>

@@ -5,7 +5,7 @@
 #include <concepts>
 #include <cstdint>
 
-#include "accel/traversal_counts.hpp"
+#include "accel/kernels/traversal_counts.hpp"
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
 

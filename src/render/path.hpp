@@ -122,9 +122,8 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   bool guided = guide == nullptr;  // the guide's vertex found (or none asked for)
   for (int depth = 0;; ++depth) {
     // Each sample is drawn before the ray it waits for is traced, so that its hash chain runs in
-    // the shadow of that traversal rather than after it (12 % more samples per second on the
-    // Cornell box, docs/bench/LOG.md): the light's numbers before this bounce's ray, the BSDF's
-    // (which depend on the surface hit) before the shadow ray.
+    // the shadow of that traversal rather than after it (more samples per second: docs/bench/LOG.md): the light's
+    // numbers before this bounce's ray, the BSDF's (which depend on the surface hit) before the shadow ray.
     const std::array<float, 3> u_light =
         lights.chooses() ? sampler.get<3>(light_set(depth)) : with_third(sampler.get<2>(light_set(depth)));
     Hit hit;

@@ -25,7 +25,7 @@ struct RenderContext {
   Camera camera;
   RenderSettings settings;
   Framebuffer* framebuffer = nullptr;
-  SampleRange samples;  // path: this pass's samples (ao and whitted take one, at the pixel centre)
+  SampleRange samples;  // this pass's samples (ao and whitted at one spp: the pixel centre)
   // path, --aov: where each sample's first hit adds its albedo and shading normal (for a
   // denoiser), summed and counted as the radiance is; null when not asked for.
   Framebuffer* albedo = nullptr;

@@ -1,6 +1,6 @@
 // tinyobjloader as the reference reader of MTL files: what it loads, tracer loads with the same
 // values, or refuses for a reason that would make the image wrong. Shared by the differential test
-// (tests/test_mtl_differential.cpp) and the MTL fuzz target.
+// (tests/test_mtl.cpp) and the MTL fuzz target.
 #pragma once
 
 #include <optional>

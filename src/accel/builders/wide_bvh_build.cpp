@@ -79,8 +79,7 @@ class WideBuilder {
     // Largest subtree (in triangles) first. Any-hit traversal enters the last slot first, so it
     // tries the smallest subtrees first: few triangles spanning a box as large as their siblings'
     // are large triangles (walls, floors), the likeliest occluders. Embree's builder orders its
-    // children the same way. On Sponza's AO rays: 29 % fewer nodes and 7x fewer L1 misses per ray
-    // (docs/bench/LOG.md).
+    // children the same way; docs/bench/LOG.md measures what it saves on Sponza's AO rays.
     std::stable_sort(kids, kids + count, [](const PrimRange& a, const PrimRange& b) { return a.size() > b.size(); });
     WideNode& w = scratch_[self];
     PrimRange inner[kWideWidth];

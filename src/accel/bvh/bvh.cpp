@@ -50,7 +50,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
       const ChildHits c = test_children(node, nodes_.data(), tris_.data(), box, ray.tnear, hit.t);
       // Branches, not selects, decide the order: a predicted branch lets the next node's load
       // start before the box tests finish, where a select would make it wait for them
-      // (measured: selects here cost 20-40 % of primary-ray throughput).
+      // (selects here were measured slower: docs/bench/LOG.md).
       if (c.a) {
         if (!c.b) {
           current = node.index;
@@ -97,7 +97,7 @@ inline bool Bvh::occluded_below(uint32_t node, const Ray& ray, const RayShear& s
     } else {
       // Children are tested from the parent. Any hit ends the query, so no order is needed:
       // the left child goes first, the right one is pushed when both are entered. Branches
-      // choose the next node (as in intersect()): selects made AO rays 9 % slower.
+      // choose the next node, as in intersect().
       const ChildHits c = test_children(n, nodes_.data(), tris_.data(), box, ray.tnear, ray.tfar);
       if (c.a) {
         stack[sp] = n.index + 1;

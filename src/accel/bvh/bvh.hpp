@@ -39,7 +39,7 @@ struct BvhBuildOptions {
   // binary tree keeps one leaf per triangle.
   float split_budget = 0.0f;
   // Relative costs for the SAH. 1.5 rather than 1 for a node step: traversal measured the same
-  // on every scene (docs/BENCHMARKS.md section 4), with 10-25 % fewer nodes to build and store.
+  // on every scene, with fewer nodes to build and store (docs/BENCHMARKS.md section 4).
   float traversal_cost = 1.5f;
   float intersection_cost = 1.0f;
   // Polled once per node split: when set, the build stops splitting and the constructor throws

@@ -1,5 +1,5 @@
 // The per-lane constants of a RayBundle and its box test, one SIMD lane per ray: shared by the
-// binary BVH's bundles (bvh_bundles.cpp) and the 8-wide BVH's (wide_bvh.cpp). Per-target code:
+// binary BVH's bundles (bvh_bundles.cpp) and the 8-wide BVH's (wide_bvh_bundles.cpp). Per-target code:
 // include it after foreach_target.h; the guard toggles per target as Highway's -inl.h
 // convention requires.
 #if defined(TRACER_ACCEL_RAY_BUNDLE_INL_H_) == defined(HWY_TARGET_TOGGLE)
@@ -14,10 +14,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include "accel/bvh/bvh.hpp"
 #include "accel/kernels/simd_lanes-inl.h"
 #include "accel/kernels/triangle_test.hpp"
 #include "math/ray_packet.hpp"
+#include "scene/scene.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {

@@ -1,7 +1,6 @@
-// Packing triangles eight to a SIMD pack (SoA), for the 8-wide BVH's leaves and SIMD brute force.
-#include <limits>
+#include "accel/kernels/triangle_pack.hpp"
 
-#include "accel/wide_bvh/wide_bvh.hpp"
+#include <limits>
 
 namespace tracer {
 

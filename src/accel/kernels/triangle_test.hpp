@@ -56,8 +56,8 @@ inline bool intersect_triangle(const RayShear& s, const Triangle& tri, float tne
     st.w = float(double(st.bx) * double(st.ay) - double(st.by) * double(st.ax));
   }
   // Bitwise | and & inside passes_outside rather than || and &&: each sign is as unpredictable as
-  // the ray, and a chain of short-circuit branches mispredicted often enough to cost 12 % of
-  // AO-ray throughput.
+  // the ray, and a chain of short-circuit branches mispredicts (docs/bench/LOG.md measures the
+  // AO-ray throughput it cost).
   if (passes_outside<L>(st)) return false;
   const TriangleLanes<L> h = triangle_hit<L>(st, false, s.sz, tnear, tfar);
   if (!h.hit) return false;

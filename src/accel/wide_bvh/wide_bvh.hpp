@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "accel/bvh/bvh.hpp"
-#include "accel/traversal_counts.hpp"
+#include "accel/kernels/traversal_counts.hpp"
+#include "accel/kernels/triangle_pack.hpp"
 #include "math/ray_packet.hpp"
 
 namespace tracer {
@@ -21,8 +22,6 @@ enum class SimdTarget { Auto, Avx512, Avx2, Sse4 };
 inline constexpr EnumName<SimdTarget> kSimdTargetNames[] = {
     {SimdTarget::Auto, "auto"}, {SimdTarget::Avx512, "avx512"}, {SimdTarget::Avx2, "avx2"}, {SimdTarget::Sse4, "sse4"}};
 
-inline constexpr int kWideWidth = 8;
-
 struct alignas(64) WideNode {
   // Children's boxes, one lane per child; an empty slot has lo = +inf, hi = -inf and never hits.
   float lo_x[kWideWidth], lo_y[kWideWidth], lo_z[kWideWidth];
@@ -31,16 +30,6 @@ struct alignas(64) WideNode {
   uint32_t count[kWideWidth];  // 0: inner child; > 0: leaf of `count` triangles in pack `child`
 };
 static_assert(sizeof(WideNode) == 256);
-
-// Up to eight triangles in SoA form, one per lane, tested against one ray in one SIMD pass.
-// Unused lanes hold NaN vertices, which fail every comparison and so never hit.
-struct alignas(64) TrianglePack {
-  float v[3][3][kWideWidth];  // [vertex][axis][lane]
-  // The scene triangle in each lane (its index in Scene::triangles, which the exact-edge fallback
-  // and the any-hit bundles read), or kInvalidIndex for padding: a hit names its triangle with
-  // no further lookup.
-  uint32_t id[kWideWidth];
-};
 
 // Packs and nodes, 64-byte aligned, on huge pages when large; packs are left uninitialised by
 // resize() (the build fills them in parallel).
@@ -98,26 +87,5 @@ class WideBvh {
   Aabb bounds_;
   bool spatial_splits_ = false;
 };
-
-// The study's brute-force SIMD variant (its ISPC kernel): every ray against every triangle, eight
-// at a time, through the same pack kernel as the wide BVH's leaves.
-class SimdBruteForce {
- public:
-  explicit SimdBruteForce(const Scene& scene);
-  bool intersect(const Ray& ray, Hit& hit) const;
-  bool occluded(const Ray& ray) const;
-  const std::vector<TrianglePack>& packs() const { return packs_; }
-  const Scene& scene() const { return *scene_; }
-  size_t memory_bytes() const { return packs_.size() * sizeof(TrianglePack); }
-
- private:
-  const Scene* scene_;
-  std::vector<TrianglePack> packs_;
-};
-
-// Packs the scene triangles ids[first, first+count) (count <= 8) into one TrianglePack: lane k
-// holds triangles[ids[first + k]] and that id; padding lanes are NaN.
-TrianglePack make_triangle_pack(std::span<const Triangle> triangles, std::span<const uint32_t> ids, uint32_t first,
-                                uint32_t count);
 
 }  // namespace tracer

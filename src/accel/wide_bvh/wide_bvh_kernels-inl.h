@@ -225,8 +225,8 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
     next = {n.child[near], n.count[near], t[near]};
     return true;
   }
-  // Sorted in place on top of the stack (a local array copied over afterwards compiled to a
-  // rep movs, 3 % of a path render's time in Sponza).
+  // Sorted in place on top of the stack: a local array copied over afterwards compiled to a
+  // rep movs that showed in a path render's profile (docs/bench/LOG.md).
   StackEntry* hits = stack + sp;
   int k = 0;
   bits |= (1u << i) | (1u << j);
