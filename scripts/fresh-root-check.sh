@@ -53,10 +53,21 @@ bind /sys "$root/sys"
 bind /dev "$root/dev"
 mkdir -p "$root/dev/shm" && mount -t tmpfs tmpfs "$root/dev/shm" && mounts+=("$root/dev/shm")
 cp /etc/resolv.conf "$root/etc/resolv.conf"
+# The machine's own network trust, not the project's: where egress goes through a proxy with its
+# own certificate authority (/usr/local/share/ca-certificates), the root trusts it too, and node
+# (npm) is pointed at the system's bundle as the host's NODE_EXTRA_CA_CERTS does.
+if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+  mkdir -p "$root/usr/local/share/ca-certificates"
+  cp /usr/local/share/ca-certificates/*.crt "$root/usr/local/share/ca-certificates/"
+fi
+extra_ca=${NODE_EXTRA_CA_CERTS:+NODE_EXTRA_CA_CERTS=/etc/ssl/certs/ca-certificates.crt}
 in_root() { chroot "$root" env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-  bash -c "cd /work/main && $1"; }
+  $extra_ca bash -c "cd /work/main && $1"; }
 step "the root has no g++ or cmake" in_root '! command -v g++ && ! command -v cmake'
 step "scripts/setup.sh" in_root scripts/setup.sh
 step "render.png written" in_root 'test -s render.png'
+if compgen -G "$root/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+  step "the machine's certificate authorities" in_root update-ca-certificates
+fi
 step "scripts/test.sh (CI=true: the browser test may not be skipped)" in_root "CI=true scripts/test.sh"
 echo "fresh-root-check: the README's two commands pass on a fresh Debian 12 root (log: $log)"
