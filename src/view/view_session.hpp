@@ -25,41 +25,9 @@
 #include "film/tone_map.hpp"
 #include "parallel/executor.hpp"
 #include "view/frame_store.hpp"
+#include "view/view_state.hpp"
 
 namespace tracer::view {
-
-// The largest image the viewer renders, per side. At 4096 x 4096 its buffers take ~750 MB (the
-// film of sums and counts, 268 MB; its displayed copy, 268 MB; a download's snapshot while one is
-// made, 268 MB at most; the 8-bit image, 50 MB; measured 724 MB), 181 MB at 2048 x 2048.
-inline constexpr int kMaxViewSide = 4096;
-
-// The flags of a `tracer render` command that the viewer's state sets, each taking one value. The
-// viewer's "copy command" drops them from the user's own flags and writes the current ones.
-inline constexpr const char* kStateFlags[] = {"--eye",
-                                              "-v",
-                                              "--look",
-                                              "--up",
-                                              "--fov",
-                                              "--width",
-                                              "--height",
-                                              "--spp",
-                                              "--integrator",
-                                              "--max-depth",
-                                              "--exposure",
-                                              "-l",
-                                              "--aperture",
-                                              "--focus-distance",
-                                              "--noise-threshold",
-                                              "--min-spp"};
-
-// The command line of `tracer render` for `args`: `user_flags` (the view command's own arguments)
-// without the state's flags and the viewer's own (`viewer_flags`, each taking one value), then the
-// state's, every value written so that it parses back to the same float. Shell-quoted.
-std::string render_command(const driver::RenderArgs& args, const std::vector<std::string>& user_flags,
-                           const std::vector<std::string>& viewer_flags);
-
-// Quotes a word for a POSIX shell when it needs it.
-std::string shell_quote(const std::string& word);
 
 class ViewSession {
  public:
