@@ -1,4 +1,6 @@
-// The binned SAH and object-median splits shared by the binary and 8-wide BVH builders.
+// The splitter shared by the binary and 8-wide BVH builders: bounds, the choice among the binned
+// SAH (sah_bins.hpp), spatial splits (spatial_split.hpp) and the object median, and the
+// partition in place.
 #include "accel/builders/prim_split.hpp"
 
 #include <algorithm>
@@ -6,14 +8,13 @@
 #include <utility>
 #include <vector>
 
+#include "accel/builders/sah_bins.hpp"
 #include "accel/builders/spatial_split.hpp"
 
 namespace tracer {
 namespace {
 
-constexpr uint32_t kPartitionBlock = 16384;    // block size of the parallel passes
 constexpr uint32_t kMedianFallbackDepth = 64;  // SAH switches to object median below this depth
-constexpr int kMaxBins = 32;
 // Spatial splits are tried only where the object split's two boxes overlap by more than this
 // fraction of the root's area (Stich et al.'s alpha). Their 1e-5 tried Sponza's spatial binning
 // at 5261 nodes to take 312; 1e-3 keeps the same nodes per ray at half the build time
@@ -41,73 +42,6 @@ struct Bounds4 {
   Aabb centroids() const { return SseBox::to_aabb(clo, chi); }
 };
 
-// Plain floats so a BinSet is trivially constructible: only the `nb` bins in use are
-// initialised, which matters because most nodes are small.
-// Four lanes (the fourth unused) so each min/max below compiles to one SSE instruction.
-struct RawBin {
-  __m128 lo, hi;
-  uint32_t count;
-  void reset() {
-    lo = _mm_set1_ps(kInfinity);
-    hi = _mm_set1_ps(-kInfinity);
-    count = 0;
-  }
-  void add(const PrimRef& r) {
-    lo = _mm_min_ps(lo, r.lo);
-    hi = _mm_max_ps(hi, r.hi);
-    ++count;
-  }
-  void add(const RawBin& o) {
-    lo = _mm_min_ps(lo, o.lo);
-    hi = _mm_max_ps(hi, o.hi);
-    count += o.count;
-  }
-  // Aabb::half_area() of a non-empty bin, summed in the same order, without leaving SSE.
-  float half_area() const {
-    const __m128 e = _mm_and_ps(_mm_sub_ps(hi, lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
-    const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy, yz, zx, 0
-    const __m128 xy_yz = _mm_add_ss(p, _mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1)));
-    return _mm_cvtss_f32(_mm_add_ss(xy_yz, _mm_movehl_ps(p, p)));  // (xy + yz) + zx
-  }
-};
-
-struct BinSet {
-  int nb;
-  RawBin bins[3][kMaxBins];
-  explicit BinSet(int n) : nb(n) {
-    for (auto& axis : bins)
-      for (int b = 0; b < nb; ++b) axis[b].reset();
-  }
-  void join(const BinSet& o) {
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < nb; ++b) bins[a][b].add(o.bins[a][b]);
-  }
-};
-
-// Maps a centroid coordinate to its bin: precomputed offset and scale, no division per primitive.
-// The float clamp before truncation gives what clamping the truncated int would; both paths
-// below compute the same bin for the same centroid, which the partition relies on.
-struct Binner {
-  alignas(16) float lo[4], scale[4];
-  float top;
-  Binner(const Aabb& cbox, int bins) : top(float(bins - 1)) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = cbox.lo[a];
-      const float extent = cbox.hi[a] - cbox.lo[a];
-      scale[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
-    }
-    lo[3] = scale[3] = 0.0f;
-  }
-  int operator()(float c, int axis) const {
-    return static_cast<int>(std::min(std::max((c - lo[axis]) * scale[axis], 0.0f), top));
-  }
-  // Bins of a centroid on all three axes at once (lane 3 is 0).
-  __m128i operator()(__m128 c) const {
-    const __m128 x = _mm_mul_ps(_mm_sub_ps(c, _mm_load_ps(lo)), _mm_load_ps(scale));
-    return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(top)));
-  }
-};
-
 template <int Axis>
 uint32_t median_partition(PrimRef* refs, uint32_t begin, uint32_t end) {
   const uint32_t mid = begin + (end - begin) / 2;
@@ -120,17 +54,6 @@ uint32_t median_partition(PrimRef* refs, uint32_t begin, uint32_t end) {
 }
 
 }  // namespace
-
-struct PrimSplitter::SahChoice {
-  int axis = -1;
-  int split_bin = 0;
-  float cost = 0.0f;
-  float raw = kInfinity;  // half area x primitives over both sides
-  float inv_area = 0.0f;  // of the node's box
-  int bins = 0;
-  uint32_t left_count = 0;
-  Aabb left_box, right_box;  // the children's boxes: unions of their bins' boxes, exactly
-};
 
 // Centroid bounds of the two sides of a partition, accumulated without a branch per primitive.
 struct PrimSplitter::SideCentroids {
@@ -155,7 +78,7 @@ struct PrimSplitter::SideCentroids {
 
 PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
     : options_(options), exec_(exec), tris_(scene.triangles.data()) {
-  options_.bins = std::clamp(options_.bins, 2, kMaxBins);
+  options_.bins = std::clamp(options_.bins, 2, kMaxSahBins);
   options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
   options_.split_budget = std::clamp(options_.split_budget, 0.0f, 4.0f);
   const auto n = static_cast<uint32_t>(scene.size());
@@ -224,7 +147,7 @@ bool PrimSplitter::split(PrimRange& node, PrimRange (&out)[2], bool parallel) {
       if (count <= uint32_t(options_.max_leaf) && max_component(extent) <= 0.0f) return false;
       mid = median_split(refs, begin, end, max_dimension(extent));
     } else {
-      const auto sah = sah_split(refs, node, parallel);
+      const SahSplit sah = find_sah_split(refs, node, options_.bins, exec_, parallel);
       if (sah.axis < 0) {
         if (count <= uint32_t(options_.max_leaf)) return false;
         mid = median_split(refs, begin, end, max_dimension(extent));
@@ -314,92 +237,6 @@ uint32_t PrimSplitter::median_split(PrimRef* refs, uint32_t begin, uint32_t end,
     default:
       return median_partition<2>(refs, begin, end);
   }
-}
-
-PrimSplitter::SahChoice PrimSplitter::sah_split(const PrimRef* refs, const PrimRange& node, bool parallel) const {
-  const Aabb& cbox = node.cbox;
-  // Fewer bins than primitives buy nothing: small nodes use fewer.
-  const int nb = std::clamp(4 + int(node.end - node.begin) / 16, 4, options_.bins);
-  const Binner binner(cbox, nb);
-  const auto add = [&](const PrimRef& r, BinSet& acc) {
-    alignas(16) int32_t bin[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(bin), binner(r.center()));
-    acc.bins[0][bin[0]].add(r);
-    acc.bins[1][bin[1]].add(r);
-    acc.bins[2][bin[2]].add(r);
-  };
-  const auto fill = [&](uint32_t b, uint32_t e, BinSet& acc) {
-    if (e - b < 256) {
-      for (uint32_t i = b; i < e; ++i) add(refs[i], acc);
-      return;
-    }
-    // Neighbouring primitives often land in the same bin; alternating between two bin sets
-    // breaks the store-to-load chain through that bin. min/max and counts merge exactly.
-    BinSet odd(acc.nb);
-    uint32_t i = b;
-    for (; i + 1 < e; i += 2) {
-      add(refs[i], acc);
-      add(refs[i + 1], odd);
-    }
-    if (i < e) add(refs[i], acc);
-    acc.join(odd);
-  };
-  // Sequentially the bins are filled in place: a BinSet is kilobytes, and copying it per node
-  // costs more than the binning itself.
-  BinSet bins(nb);
-  if (parallel) {
-    bins = exec_.reduce(node.begin, node.end, kPartitionBlock, BinSet(nb), [&](uint32_t b, uint32_t e, BinSet acc) {
-      fill(b, e, acc);
-      return acc;
-    });
-  } else {
-    fill(node.begin, node.end, bins);
-  }
-  // The sweep compares the split's raw area-count sum, keeping the best in scalars selected with
-  // masks (which bin wins is unpredictable, and the compiler turned ?: back into a branch); the
-  // cost is formed once, at the end.
-  uint32_t best_choice = 0, best_left = 0;  // axis * kMaxBins + bin
-  float best_raw = kInfinity;
-  for (int a = 0; a < 3; ++a) {
-    if (cbox.hi[a] <= cbox.lo[a]) continue;
-    float right_cost[kMaxBins];  // area * count of bins [s, nb)
-    RawBin acc;
-    acc.reset();
-    for (int s = nb - 1; s > 0; --s) {
-      acc.add(bins.bins[a][s]);
-      right_cost[s] = acc.count ? acc.half_area() * float(acc.count) : kInfinity;
-    }
-    acc.reset();
-    for (int s = 1; s < nb; ++s) {
-      acc.add(bins.bins[a][s - 1]);
-      const float raw = acc.count ? acc.half_area() * float(acc.count) + right_cost[s] : kInfinity;
-      const uint32_t better = 0u - uint32_t(raw < best_raw);
-      best_raw = std::min(raw, best_raw);
-      best_choice = (uint32_t(a * kMaxBins + s) & better) | (best_choice & ~better);
-      best_left = (acc.count & better) | (best_left & ~better);
-    }
-  }
-  const float inv_area = 1.0f / std::max(node.box.half_area(), 1e-30f);
-  SahChoice best;
-  best.axis = int(best_choice / kMaxBins);
-  best.split_bin = int(best_choice % kMaxBins);
-  best.left_count = best_left;
-  best.cost = options_.traversal_cost + options_.intersection_cost * best_raw * inv_area;
-  best.raw = best_raw;
-  best.inv_area = inv_area;
-  if (!(best_raw < kInfinity)) {
-    best.axis = -1;
-  } else {
-    RawBin l, r;
-    l.reset();
-    r.reset();
-    for (int b = 0; b < best.split_bin; ++b) l.add(bins.bins[best.axis][b]);
-    for (int b = best.split_bin; b < nb; ++b) r.add(bins.bins[best.axis][b]);
-    best.left_box = SseBox::to_aabb(l.lo, l.hi);
-    best.right_box = SseBox::to_aabb(r.lo, r.hi);
-  }
-  best.bins = nb;
-  return best;
 }
 
 // Partition of refs[begin, end) in place by `pred`, whose true count the binning already gave

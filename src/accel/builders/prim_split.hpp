@@ -22,6 +22,9 @@ namespace tracer {
 
 struct SpatialSplit;  // spatial_split.hpp
 
+// Primitives per block of the splitter's parallel passes (bounds, binning, partition).
+inline constexpr uint32_t kPartitionBlock = 16384;
+
 // A box in two SSE registers (lane 3 unused), as the builders bin, sweep and cut boxes.
 struct SseBox {
   __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
@@ -108,9 +111,7 @@ class PrimSplitter {
   bool split(PrimRange& r, PrimRange (&out)[2], bool parallel);
 
  private:
-  struct SahChoice;
   struct SideCentroids;
-  SahChoice sah_split(const PrimRef* refs, const PrimRange& r, bool parallel) const;
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
   bool split_spatially(PrimRange& r, const SpatialSplit& s, PrimRange (&out)[2]);
   void share_room(const PrimRange& r, uint32_t mid, PrimRange (&out)[2]);
