@@ -1,8 +1,10 @@
-// The failures a user can cause or ask for, with the exit codes the CLI maps them to. Every
-// layer throws these; only the CLI turns them into messages and exit codes.
+// The failures a user can cause or ask for, and the exit code of each (failure_of, the one place
+// an exception becomes one). Every layer throws these; only the front ends (tracer, tracer-mpi)
+// turn them into messages and exit codes.
 #pragma once
 
 #include <atomic>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +28,18 @@ class Cancelled : public std::runtime_error {
  public:
   Cancelled() : std::runtime_error("cancelled") {}
 };
+
+// What a front end reports for an exception: its kind, exit code and message. Cancelled's exit
+// code is 128 + the signal that stopped the run; 130 (SIGINT's) here, which a front end that
+// knows the signal replaces.
+struct Failure {
+  enum class Kind { Usage, Input, Cancelled, OutOfMemory, Internal };
+  Kind kind;
+  int exit_code;        // Usage 2; Input, OutOfMemory and Internal 1; Cancelled 130
+  std::string message;  // what() ("out of memory" for std::bad_alloc)
+};
+// The Failure of `e` (std::current_exception() in a catch (...) block); any exception at all.
+Failure failure_of(std::exception_ptr e);
 
 // A cancel flag a long phase polls: set asynchronously (by a signal handler or a watchdog).
 using CancelFlag = const std::atomic<bool>*;

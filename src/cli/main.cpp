@@ -223,21 +223,19 @@ int main(int argc, char** argv) {
     if (info->parsed()) return cmd_info(info_args);
     if (bench->parsed()) return run_bench(bench_args);
     if (compare->parsed()) return cmd_compare(compare_a, compare_b, compare_exposure);
-  } catch (const UsageError& e) {
-    std::cerr << "tracer: error: " << e.what() << "\n";
-    return 2;
-  } catch (const InputError& e) {
-    std::cerr << "tracer: error: " << e.what() << "\n";
-    return 1;
-  } catch (const Cancelled&) {
-    std::cerr << "tracer: " << stop_signal_name() << "; no image written\n";
-    return exit_code_for_stop();
-  } catch (const std::bad_alloc&) {
-    std::cerr << "tracer: error: out of memory\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "tracer: internal error: " << e.what() << "\n";
-    return 1;
+  } catch (...) {
+    const Failure f = failure_of(std::current_exception());
+    switch (f.kind) {
+      case Failure::Kind::Cancelled:
+        std::cerr << "tracer: " << stop_signal_name() << "; no image written\n";
+        return exit_code_for_stop();
+      case Failure::Kind::Internal:
+        std::cerr << "tracer: internal error: " << f.message << "\n";
+        return f.exit_code;
+      default:
+        std::cerr << "tracer: error: " << f.message << "\n";
+        return f.exit_code;
+    }
   }
   return 0;
 }

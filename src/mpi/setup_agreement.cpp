@@ -75,15 +75,10 @@ void set_up(RankSetup& s, const driver::RenderArgs& args, const MpiSession& sess
       std::fputs(line.c_str(), stderr);  // one write: the ranks' lines do not interleave
     }
     s.fingerprint = settings_fingerprint(*s.prepared, args);
-  } catch (const UsageError& e) {
-    s.exit_code = 2;
-    s.error = e.what();
-  } catch (const std::bad_alloc&) {
-    s.exit_code = 1;
-    s.error = "out of memory";
-  } catch (const std::exception& e) {
-    s.exit_code = 1;
-    s.error = e.what();
+  } catch (...) {
+    const Failure f = failure_of(std::current_exception());
+    s.exit_code = f.exit_code;
+    s.error = f.message;
   }
 }
 
