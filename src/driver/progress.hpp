@@ -10,7 +10,15 @@
 #include <mutex>
 #include <thread>
 
+#include "render/render_settings.hpp"
+
 namespace tracer::driver {
+
+// The pixel samples `frames` images of `settings` take at most: a progress bar's whole (adaptive
+// sampling may end sooner).
+inline uint64_t pixel_samples(const RenderSettings& s, int frames) {
+  return uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp) * uint64_t(frames);
+}
 
 class ProgressBar {
  public:

@@ -57,9 +57,7 @@ RankRender::RankRender(const driver::PreparedRender& setup, const driver::Render
       tiles_per_rank_(size_t(session.size()), 0) {
   watch_.floor_seconds = rank_timeout;
   if (session.root()) {
-    const RenderSettings& s = setup.settings;
-    const uint64_t work = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp) * uint64_t(args.frames);
-    progress_.emplace(!args.quiet, work, pixels_done_, rays_done_);
+    progress_.emplace(!args.quiet, driver::pixel_samples(setup.settings, args.frames), pixels_done_, rays_done_);
   }
 }
 
