@@ -50,9 +50,7 @@ int cmd_render(const RenderArgs& args) {
   RenderControl control;
   control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
-  const uint64_t work =
-      uint64_t(settings.width) * uint64_t(settings.height) * uint64_t(settings.spp) * uint64_t(args.frames);
-  ProgressBar progress(!args.quiet, work, control.pixels_done, control.rays_done,
+  ProgressBar progress(!args.quiet, pixel_samples(settings, args.frames), control.pixels_done, control.rays_done,
                        adaptive(settings) ? &control.active_pixels : nullptr,
                        uint64_t(settings.width) * uint64_t(settings.height));
   // Every pass a round of its own: checkpoints, and a complete image after the first on Ctrl-C.
@@ -152,16 +150,10 @@ int main(int argc, char** argv) {
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image");
   add_render_options(*render, render_args);
-  file_option(render->add_option("-o,--output", render_args.output,
-                                 "output image: .png or .ppm (tone-mapped), .exr (linear radiance)"))
-      ->capture_default_str();
-  render->add_flag("--stats", render_args.stats, "print timings, ray counts and Mrays/s");
+  add_output_options(*render, render_args, "", "timings, ray counts and Mrays/s");
   render->add_flag("--count", render_args.count,
                    "count the nodes, leaf packs and triangles each ray visits, for --stats and --stats-json "
                    "(8-wide BVH; the same image, rendered slower)");
-  file_option(render->add_option("--stats-json", render_args.stats_json,
-                                 "write the statistics as JSON to this file ('-': standard output)"));
-  render->add_flag("-q,--quiet", render_args.quiet, "no progress bar, no loader warnings");
   render->add_flag("--save-partial", render_args.save_partial,
                    "on Ctrl-C, write the image with unfinished tiles black");
 

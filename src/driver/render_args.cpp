@@ -79,6 +79,16 @@ void add_scene_options(CLI::App& app, SceneArgs& a) {
                1, 1 << 30);
 }
 
+void add_output_options(CLI::App& app, RenderArgs& a, const std::string& writer, const std::string& stats) {
+  file_option(app.add_option("-o,--output", a.output,
+                             "output image: .png or .ppm (tone-mapped), .exr (linear radiance)" + writer))
+      ->capture_default_str();
+  app.add_flag("--stats", a.stats, "print " + stats);
+  file_option(app.add_option("--stats-json", a.stats_json,
+                             "write the statistics as JSON to this file ('-': standard output)" + writer));
+  app.add_flag("-q,--quiet", a.quiet, "no progress bar, no loader warnings");
+}
+
 void add_render_options(CLI::App& app, RenderArgs& a) {
   add_scene_options(app, a.scene);
   RenderSettings& s = a.settings;

@@ -81,6 +81,9 @@ void add_scene_options(CLI::App& app, SceneArgs& args);
 // A file-name option that refuses an empty name (`--stats-json ''` silently wrote nothing).
 CLI::Option* file_option(CLI::Option* option);
 void add_render_options(CLI::App& app, RenderArgs& args);
+// -o/--output, --stats, --stats-json and -q/--quiet, as tracer render and tracer-mpi render share
+// them; `writer` says who writes the files (e.g. " (written by rank 0)"), `stats` what --stats prints.
+void add_output_options(CLI::App& app, RenderArgs& args, const std::string& writer, const std::string& stats);
 
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);

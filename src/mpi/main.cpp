@@ -105,12 +105,8 @@ int main(int argc, char** argv) {
   driver::RenderArgs args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image, on every rank");
   driver::add_render_options(*render, args);
-  driver::file_option(render->add_option("-o,--output", args.output, "output image (written by rank 0)"))
-      ->capture_default_str();
-  render->add_flag("--stats", args.stats, "print timings, ray counts and each rank's tiles, rays and idle time");
-  driver::file_option(render->add_option("--stats-json", args.stats_json,
-                                         "write the statistics as JSON to this file (rank 0; '-': standard output)"));
-  render->add_flag("-q,--quiet", args.quiet, "no progress bar, no loader warnings");
+  driver::add_output_options(*render, args, " (written by rank 0)",
+                             "timings, ray counts and each rank's tiles, rays and idle time");
   double rank_timeout = mpi::StallWatch{}.floor_seconds;
   render
       ->add_option("--rank-timeout", rank_timeout,
