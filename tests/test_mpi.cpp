@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include "io/exr_io.hpp"
 #include "test_util.hpp"
@@ -386,6 +387,8 @@ TEST_F(MpiRender, ARankWithOtherFlagsOrSettingsEndsTheJobWithOneError) {
       {" --eye 0,1,4", false, "renders with --eye "},
       {" --seed 7", false, "renders with --seed "},
       {" --tile 8", false, "renders with --tile "},
+      {" --exposure 2", false, "renders with --exposure "},
+      {" --aperture 0.1", false, "renders with --aperture "},
       {" --denoise", true, "--denoise: only for --integrator path"},
   };
   for (const auto& c : cases) {
@@ -402,6 +405,22 @@ TEST_F(MpiRender, ARankWithOtherFlagsOrSettingsEndsTheJobWithOneError) {
       EXPECT_EQ(own_lines(m.output), 1) << m.output;
       EXPECT_FALSE(fs::exists(out));
     }
+  }
+  // Path tracing's own: adaptive sampling's threshold (rank 0 judges the noise, so another rank's
+  // would be ignored) and the lens's focus, which a rank without --focus-distance takes from
+  // the look-at point: both named with the values they come to.
+  const std::string path =
+      std::string(kMpiExe) + " render --width 16 --height 16 --integrator path --spp 2 -q -o " + out;
+  for (const auto& [rank0, rank1, message] :
+       {std::tuple{" --noise-threshold 0.05", " --noise-threshold 0.1", "renders with --noise-threshold 0.1"},
+        {" --aperture 0.1 --focus-distance 2", " --aperture 0.1", "with --focus-distance 2: every rank"}}) {
+    SCOPED_TRACE(std::string(rank0) + " against" + rank1);
+    const auto m = run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 " + path + rank0 +
+                       " : -np 1 " + path + rank1);
+    EXPECT_EQ(m.exit_code, 2) << m.output;
+    EXPECT_NE(m.output.find(message), std::string::npos) << m.output;
+    EXPECT_EQ(m.output.find("--focus-distance 0,"), std::string::npos) << m.output;  // not the unset flag's 0
+    EXPECT_FALSE(fs::exists(out));
   }
 }
 

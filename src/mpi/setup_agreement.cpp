@@ -9,6 +9,7 @@
 
 #include "base/errors.hpp"
 #include "parallel/thread_count.hpp"
+#include "scene/camera.hpp"
 #include "scene/scene_checksum.hpp"
 
 namespace tracer::mpi {
@@ -46,10 +47,11 @@ std::string settings_fingerprint(const driver::PreparedRender& s, const driver::
     << "\n--env-map " << args.scene.env_map << "\n--env-rotation " << args.scene.env_rotation << "\n--env "
     << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
     << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--aperture " << s.camera.lens_radius
-    << "\n--focus-distance " << s.camera.focus_distance << "\n--frames " << args.frames << "\n--orbit " << args.orbit
-    << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--denoise " << (args.denoise ? "on" : "off")
-    << "\n--sched " << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile " << s.sched.tile << "\n--block "
-    << s.sched.block << "\n";
+    << "\n--focus-distance " << Camera(s.camera, r.width, r.height).focus_distance() << "\n--exposure " << r.exposure
+    << "\n--noise-threshold " << r.noise_threshold << "\n--min-spp " << r.min_spp << "\n--frames " << args.frames
+    << "\n--orbit " << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--denoise "
+    << (args.denoise ? "on" : "off") << "\n--sched " << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile "
+    << s.sched.tile << "\n--block " << s.sched.block << "\n";
   return f.str();
 }
 
