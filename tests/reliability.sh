@@ -52,6 +52,7 @@ printf 'glTF\001\000\000\000\024\000\000\000\000\000\000\000JSON' > v1.glb
 cp ok.obj ok.stl 2>/dev/null || printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > ok.stl
 ply='ply\nformat %s 1.0\nelement vertex %s\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > tri.ply
+printf 'v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf 1 1 2\nf 3 3 3\n' > degen.obj
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 4000000000 > count.ply
 printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n' ascii 3 > range.ply
 printf "$ply"'0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > extra.ply
@@ -295,6 +296,7 @@ cases=(
   "--aperture 0.1 --focus-distance 1e-30|tracer render --aperture 0.1 --focus-distance 1e-30 -q|2"
   "--build-quality HIGH (names are exact)|tracer render --build-quality HIGH -q|2"
   "bench --build-quality high|tracer bench --size 8x8 --runs 1 --best 1 --variants bvh8 --scenes ok.obj --build-quality high > /dev/null|0"
+  "bench on zero-area triangles only, every kind of accelerator|tracer bench --size 8x8 --runs 1 --best 1 --variants seq,bvh,simd-brute,sah,bvh8,best,bvh8-high,embree,embree-packets,embree-high --scenes degen.obj > /dev/null|0"
   "tracer view: SIGINT 50 ms after start, in the background|tracer view ok.obj --port 0 -q > /dev/null & sleep 0.05 ; kill -INT \$! ; wait \$!|130"
   "Ctrl-C while Sponza loads and builds at high quality|timeout --foreground --preserve-status -s INT 0.5 tracer render shared-scenes/sponza/sponza.obj --build-quality high -q|130"
   "all vertices coincide, no camera flags|tracer render same.obj -q|1"
@@ -380,6 +382,9 @@ cases=(
   "a bad views.tsv beside the scene|tracer render viewsdir/tri.obj --width 8 --height 8 -o v.png|0"
   "tracer-mpi: one rank refuses a flag (an older binary)|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png --newer-flag|2"
   "tracer-mpi: ranks given different --width|$MPIRUN -np 1 tracer-mpi render -q --width 32 --height 32 -o m.png : -np 1 tracer-mpi render -q --width 64 --height 32 -o m.png|2"
+  "tracer-mpi: ranks given different --noise-threshold (rank 0 judges the noise)|$MPIRUN -np 1 tracer-mpi render -q --integrator path --spp 2 --width 16 --height 16 --noise-threshold 0.05 -o m.png : -np 1 tracer-mpi render -q --integrator path --spp 2 --width 16 --height 16 --noise-threshold 0.1 -o m.png|2"
+  "tracer-mpi: one rank focuses at 2, the other at the look-at point|$MPIRUN -np 1 tracer-mpi render -q --integrator path --spp 2 --width 16 --height 16 --aperture 0.1 --focus-distance 2 -o m.png : -np 1 tracer-mpi render -q --integrator path --spp 2 --width 16 --height 16 --aperture 0.1 -o m.png|2"
+  "tracer-mpi: adaptive sampling and a lens on a glTF scene and a PLY scene|$MPIRUN -np 2 tracer-mpi render tri.gltf -q --integrator path --spp 8 --width 16 --height 16 --noise-threshold 0.05 --aperture 0.05 -o mg.png && $MPIRUN -np 2 tracer-mpi render tri.ply -q --integrator path --spp 8 --width 16 --height 16 --noise-threshold 0.05 -o mp.png|0"
   "tracer-mpi: rank 0 stopped (SIGSTOP) mid-render|stall_rank 0 $MPIRUN -np 2 tracer-mpi render -q --integrator path --spp 4096 --width 96 --height 96 --threads 1 --rank-timeout 1 -o m0.png|1"
   "tracer-mpi: rank 1 stopped (SIGSTOP) in start-up (the job fails: exit 0 here)|! stall_rank 1 --at-start $MPIRUN -np 3 tracer-mpi render -q --integrator ao --width 32 --height 32 --startup-timeout 3 -o m1.png|0"
   "tracer-mpi: one --env-map path, two files (other working directories)|$MPIRUN -np 1 -wdir envA tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png : -np 1 -wdir envB tracer-mpi render -q --integrator path --spp 1 --width 8 --height 8 --env-map sky.exr -o m2.png|1"
