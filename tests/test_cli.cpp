@@ -116,6 +116,7 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --accel bvh8 --simd off", 2, "--simd off: bvh8 is the SIMD tree"},
       {"render --simd-target neon", 2, "--simd-target: unknown target 'neon'"},
       {"render --accel brute --packets", 2, "--packets: needs --accel bvh, bvh8 or embree"},
+      {"render --accel simd-brute --simd off", 2, "--simd off: simd-brute is the SIMD brute force"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
       {"render --traversal-cost 0", 2, "--traversal-cost: must be above 0"},
       {"render --traversal-cost nan", 2, "--traversal-cost"},

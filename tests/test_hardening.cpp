@@ -122,7 +122,7 @@ TEST_F(Hardening, CoordinatesAtTheEdgeOfTheRangeRenderOnEveryAccelerator) {
   std::ofstream(in("edge.obj")) << "v -1e12 -1e12 0\nv 1e12 -1e12 0\nv 0 1e12 0\nf 1 2 3\n";
   std::ofstream(in("past.obj")) << "v -1.0001e12 -1e12 0\nv 1e12 -1e12 0\nv 0 1e12 0\nf 1 2 3\n";
   std::string reference;
-  for (const char* accel : {"brute", "bvh", "bvh8", "embree"}) {
+  for (const char* accel : {"brute", "simd-brute", "bvh", "bvh8", "embree"}) {
     SCOPED_TRACE(accel);
     const std::string out = in(std::string(accel) + ".ppm");
     const auto r = test::run_tracer("render " + in("edge.obj") + " -q --integrator ao --ao 0 --width 16 --height 16" +

@@ -111,7 +111,7 @@ void expect_no_leaks(const IndexedMesh& mesh, Vec3 inside, float jitter) {
   // Brute force is O(N) per ray: a prefix of the same rays.
   const std::vector<Ray> some(rays.begin(), rays.begin() + std::min<size_t>(rays.size(), 20'000));
   EXPECT_EQ(leaks(build_accelerator(scene, AccelOptions{.kind = AccelKind::Brute}), some), 0u) << "brute";
-  EXPECT_EQ(leaks(build_accelerator(scene, AccelOptions{.kind = AccelKind::BruteSimd}), some), 0u) << "brute-simd";
+  EXPECT_EQ(leaks(build_accelerator(scene, AccelOptions{.kind = AccelKind::BruteSimd}), some), 0u) << "simd-brute";
   if (embree_available()) {
     // The adapter runs Embree in its default mode, as the benchmarks do, whose triangle test is
     // not watertight (RTC_SCENE_FLAG_ROBUST is off): its leaks are reported, not asserted.

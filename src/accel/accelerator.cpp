@@ -39,7 +39,7 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       break;
     case AccelKind::BruteSimd:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<SimdBruteForce>, scene);
-      acc.name = "brute-simd-" + WideBvh::simd_target();
+      acc.name = "simd-brute-" + WideBvh::simd_target();
       break;
     case AccelKind::Bvh:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);

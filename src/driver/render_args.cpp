@@ -166,7 +166,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
   app.add_option("--traversal-cost", a.bvh.traversal_cost,
                  "SAH BVH: cost of a node step relative to a triangle test (0-100)")
       ->capture_default_str();
-  app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (--accel brute: the scalar baseline)")
+  app.add_option("--simd", a.simd, "SIMD kernels: auto, or off (scalar traversal: --accel bvh by default)")
       ->capture_default_str();
   app.add_option(
          "--simd-target", a.simd_target,

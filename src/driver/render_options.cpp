@@ -98,9 +98,11 @@ AccelOptions accel_options_for(const RenderArgs& a) {
   // --simd off alone asks for the scalar baseline: the binary BVH, not the SIMD default.
   const AccelKind fallback = simd == "off" ? AccelKind::Bvh : o.kind;
   o.kind = a.accel ? parse_name<AccelKind>(kAccelKindNames, *a.accel, "--accel", "accelerator") : fallback;
-  if (o.kind == AccelKind::BruteSimd && simd == "off") o.kind = AccelKind::Brute;
   if (o.kind == AccelKind::Bvh8 && simd == "off") {
     throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
+  }
+  if (o.kind == AccelKind::BruteSimd && simd == "off") {
+    throw UsageError("--simd off: simd-brute is the SIMD brute force; use --accel brute for the scalar one");
   }
   o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
   o.bvh.mode = parse_name<BuildMode>(kBuildModeNames, a.build, "--build", "builder");
