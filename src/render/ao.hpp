@@ -25,11 +25,11 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
   return dot(d, n) < 0.0f ? -d : d;
 }
 
-// Adds the ambient term, scaled by the fraction of `si`'s AO rays that escape, and returns the
-// pixel's colour.
+// `direct` (the hit's emission and lamp light) plus the ambient term, scaled by the fraction of
+// `si`'s AO rays that escape: the pixel's colour.
 template <class Accel>
 Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfaceInteraction& si,
-                         RayCounts& counts, uint32_t sample = 0) {
+                         Vec3 direct, RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
   float unoccluded = 1.0f;
   if (s.ao_samples > 0) {
@@ -69,7 +69,7 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
     counts.ao += uint64_t(s.ao_samples);
     unoccluded = float(open) / float(s.ao_samples);
   }
-  return si.color + si.mat->kd * (s.ambient * unoccluded);
+  return direct + si.mat->kd * (s.ambient * unoccluded);
 }
 
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
@@ -77,9 +77,9 @@ template <class Accel>
 Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
                RayCounts& counts, uint32_t sample = 0) {
   if (!hit.valid()) return Vec3{0.0f};
-  SurfaceInteraction si = surface_interaction(ctx, primary, hit);
-  add_lamp_light(accel, ctx, si, counts);
-  return finish_with_ambient(accel, ctx, x, y, si, counts, sample);
+  const SurfaceInteraction si = surface_interaction(ctx, primary, hit);
+  const Vec3 direct = add_lamp_light(accel, ctx, si, si.mat->ke, counts);
+  return finish_with_ambient(accel, ctx, x, y, si, direct, counts, sample);
 }
 
 template <class Accel>
@@ -92,9 +92,9 @@ Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, Ray
 }
 
 // A 4x4 pixel block at (bx, by), clipped to the tile: its primary rays as one packet, then per
-// light its shadow rays as one packet (one call where the accelerator takes occlusion packets),
-// then each hit's AO rays. Each ray gets the answer it gets alone and every pixel sums its lights
-// in the same order, so the image is the one shade_pixel() makes.
+// light its shadow rays as one packet (add_lamp_light's packet form), then each hit's AO rays.
+// Each ray gets the answer it gets alone and every pixel sums its lights in the same order, so
+// the image is the one shade_pixel() makes.
 template <class Accel>
 void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile, int bx, int by, RayCounts& counts) {
   RayPacket packet;
@@ -119,37 +119,13 @@ void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile,
     sis[k] = surface_interaction(ctx, rays[k], hits[k]);
     lit |= 1u << k;
   }
-  for (const Light& light : ctx.scene->lights) {
-    RayPacket shadows;
-    Vec3 contribution[kPacketSize];
-    for (uint32_t bits = lit; bits; bits &= bits - 1) {
-      const int k = __builtin_ctz(bits);
-      LightSample ls;
-      float cos_surface;
-      if (!lamp_sample_at(light, sis[k], ls, cos_surface)) continue;
-      shadows.set(k, shadow_ray(sis[k], ls));
-      contribution[k] = light_contribution(ls, sis[k].albedo_over_pi, cos_surface);
-    }
-    if (shadows.active == 0) continue;
-    counts.shadow += uint64_t(std::popcount(shadows.active));
-    uint32_t blocked = 0;
-    if constexpr (OcclusionPacketAccelerator<Accel>) {
-      blocked = accel.occluded_packet(shadows);
-    } else {
-      for (uint32_t bits = shadows.active; bits; bits &= bits - 1) {
-        const int k = __builtin_ctz(bits);
-        if (occluded_leaving(accel, shadows.ray(k), sis[k].tri)) blocked |= 1u << k;
-      }
-    }
-    for (uint32_t bits = shadows.active & ~blocked; bits; bits &= bits - 1) {
-      const int k = __builtin_ctz(bits);
-      sis[k].color += contribution[k];
-    }
-  }
+  Vec3 direct[kPacketSize];
+  for (uint32_t bits = lit; bits; bits &= bits - 1) direct[__builtin_ctz(bits)] = sis[__builtin_ctz(bits)].mat->ke;
+  add_lamp_light(accel, ctx, sis, lit, direct, counts);
   for (uint32_t bits = lit; bits; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
     const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-    ctx.framebuffer->add(x, y, finish_with_ambient(accel, ctx, x, y, sis[k], counts));
+    ctx.framebuffer->add(x, y, finish_with_ambient(accel, ctx, x, y, sis[k], direct[k], counts));
   }
 }
 

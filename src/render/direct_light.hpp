@@ -2,6 +2,9 @@
 // sample adds through a surface's reflectance, and the study's sum over every lamp (ao, whitted).
 #pragma once
 
+#include <bit>
+#include <cstdint>
+
 #include "render/accel_concepts.hpp"
 #include "render/lights.hpp"
 
@@ -40,15 +43,52 @@ inline bool lamp_sample_at(const Light& light, const SurfaceInteraction& si, Lig
   return cos_surface > 0.0f;
 }
 
-// Adds to si.color what every lamp gives it, in the lamps' order.
+// `radiance` plus what every lamp gives `si`, added in the lamps' order.
 template <class Accel>
-void add_lamp_light(const Accel& accel, const RenderContext& ctx, SurfaceInteraction& si, RayCounts& counts) {
+Vec3 add_lamp_light(const Accel& accel, const RenderContext& ctx, const SurfaceInteraction& si, Vec3 radiance,
+                    RayCounts& counts) {
   for (const Light& light : ctx.scene->lights) {
     LightSample ls;
     float cos_surface;
     if (!lamp_sample_at(light, si, ls, cos_surface)) continue;
-    const Vec3 added = direct_light(accel, si, ls, si.albedo_over_pi, cos_surface, counts);
-    si.color += added;
+    radiance += direct_light(accel, si, ls, si.albedo_over_pi, cos_surface, counts);
+  }
+  return radiance;
+}
+
+// add_lamp_light() for the lanes `lanes` of up to kPacketSize hits at once: per lamp, their
+// shadow rays as one packet (one call where the accelerator takes occlusion packets). Each ray
+// gets the answer it gets alone and each lane adds the lamps in the same order, so every
+// radiance[k] is the single-hit one.
+template <class Accel>
+void add_lamp_light(const Accel& accel, const RenderContext& ctx, const SurfaceInteraction* sis, uint32_t lanes,
+                    Vec3* radiance, RayCounts& counts) {
+  for (const Light& light : ctx.scene->lights) {
+    RayPacket shadows;
+    Vec3 contribution[kPacketSize];
+    for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      LightSample ls;
+      float cos_surface;
+      if (!lamp_sample_at(light, sis[k], ls, cos_surface)) continue;
+      shadows.set(k, shadow_ray(sis[k], ls));
+      contribution[k] = light_contribution(ls, sis[k].albedo_over_pi, cos_surface);
+    }
+    if (shadows.active == 0) continue;
+    counts.shadow += uint64_t(std::popcount(shadows.active));
+    uint32_t blocked = 0;
+    if constexpr (OcclusionPacketAccelerator<Accel>) {
+      blocked = accel.occluded_packet(shadows);
+    } else {
+      for (uint32_t bits = shadows.active; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        if (occluded_leaving(accel, shadows.ray(k), sis[k].tri)) blocked |= 1u << k;
+      }
+    }
+    for (uint32_t bits = shadows.active & ~blocked; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(bits);
+      radiance[k] += contribution[k];
+    }
   }
 }
 

@@ -17,10 +17,9 @@ inline Vec3 offset_origin(Vec3 p, Vec3 n) {
   return p + n * eps;
 }
 
-// A hit being shaded: the normal on the side the ray came from, the origin of the rays it sends,
-// and (for the ao and whitted integrators) the colour so far.
+// A hit being shaded: the normal on the side the ray came from and the origin of the rays it sends.
 struct SurfaceInteraction {
-  Vec3 position, n, origin, albedo_over_pi, color;  // origin: position moved off the surface along n
+  Vec3 position, n, origin, albedo_over_pi;  // origin: position moved off the surface along n
   Vec3 shading_n;  // the normal shading uses: n, or the interpolated vertex normal on n's side
   bool front;      // the ray hit the side the triangle's winding faces
   const Material* mat;
@@ -41,7 +40,6 @@ inline SurfaceInteraction surface_interaction(const RenderContext& ctx, const Ra
   si.shading_n = si.n;
   si.origin = offset_origin(p, si.n);
   si.albedo_over_pi = si.mat->kd * std::numbers::inv_pi_v<float>;
-  si.color = si.mat->ke;
   si.tri = hit.tri;
   si.geomID = hit.geomID;
   return si;

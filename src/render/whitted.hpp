@@ -20,6 +20,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   Hit hit;
   if (!accel.intersect(ray, hit)) return EnvironmentLight::of(ctx).radiance(ray.dir);
   SurfaceInteraction si = surface_interaction(ctx, ray, hit);  // si.n faces the ray's side
+  const Vec3 emitted = si.mat->ke;
   si.shading_n = interpolated_normal(*ctx.scene, hit, si.n);
   const Material& mat = *si.mat;
   si.shading_n = bumped_normal(*ctx.scene, hit, mat, si.shading_n, -ray.dir);
@@ -27,22 +28,22 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   const RayCone next{cone.width_at(hit.t), cone.spread};  // mirrors and glass carry the footprint on
   switch (mat.surface()) {
     case SurfaceKind::Mirror: {
-      if (!deeper) return si.color;
+      if (!deeper) return emitted;
       Ray reflected;
       reflected.org = si.origin;
       reflected.dir = reflect(ray.dir, si.shading_n);
       ++counts.secondary;
-      return si.color + mat.ks * whitted_radiance(accel, ctx, reflected, depth + 1, counts, next);
+      return emitted + mat.ks * whitted_radiance(accel, ctx, reflected, depth + 1, counts, next);
     }
     case SurfaceKind::Dielectric: {
-      if (!deeper) return si.color;
+      if (!deeper) return emitted;
       const float eta_i = si.front ? 1.0f : mat.ni, eta_t = si.front ? mat.ni : 1.0f;  // front: entering
       const float f = fresnel_dielectric(-dot(ray.dir, si.shading_n), eta_i, eta_t);
       Ray reflected;
       reflected.org = si.origin;
       reflected.dir = reflect(ray.dir, si.shading_n);
       ++counts.secondary;
-      Vec3 color = si.color + whitted_radiance(accel, ctx, reflected, depth + 1, counts, next) * f;
+      Vec3 color = emitted + whitted_radiance(accel, ctx, reflected, depth + 1, counts, next) * f;
       Vec3 transmitted;
       if (f < 1.0f && refract(ray.dir, si.shading_n, eta_i / eta_t, transmitted)) {
         Ray refracted;
@@ -58,8 +59,7 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   }
   const Vec3 kd = diffuse_color(*ctx.scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
   si.albedo_over_pi = kd * std::numbers::inv_pi_v<float>;
-  add_lamp_light(accel, ctx, si, counts);
-  return si.color + kd * ctx.settings.ambient;
+  return add_lamp_light(accel, ctx, si, emitted, counts) + kd * ctx.settings.ambient;
 }
 
 }  // namespace tracer
