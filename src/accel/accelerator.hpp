@@ -94,8 +94,9 @@ struct Accelerator {
 
 bool embree_available();
 
-// Whether `kind` traces packets or bundles (--packets): the BVHs and Embree.
-inline bool has_packet_kernels(AccelKind kind) {
+// Whether `kind` has kernels that trace rays together (what --packets turns on): packets of
+// primary and shadow rays (bvh8, Embree) and bundles of one hit's AO rays (the binary BVH too).
+inline bool traces_rays_together(AccelKind kind) {
   return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || is_embree(kind);
 }
 

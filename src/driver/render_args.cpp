@@ -223,7 +223,7 @@ void validate(const RenderArgs& a) {
   }
   for (const auto& l : a.scene.lights) parse_point("--light", l);
   const AccelOptions accel = accel_options_for(a);
-  if (a.packets && !has_packet_kernels(accel.kind)) {
+  if (a.packets && !traces_rays_together(accel.kind)) {
     throw UsageError("--packets: needs --accel bvh, bvh8 or embree (the accelerators with packet kernels)");
   }
   sched_options_for(a);

@@ -32,7 +32,7 @@ RenderSettings settings_for(const RenderArgs& a) {
   // not for whitted, whose rays go one at a time.
   const bool by_default = s.packets && !a.no_packets && a.simd != "off";
   s.packets =
-      (a.packets || by_default) && has_packet_kernels(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
+      (a.packets || by_default) && traces_rays_together(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
   if (a.count && accel_options_for(a).kind != AccelKind::Bvh8) {
     throw UsageError("--count: only the 8-wide BVH counts its traversal (--accel bvh8, the default)");
   }
