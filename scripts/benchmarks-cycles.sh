@@ -12,7 +12,8 @@
 #   - samples per second, and seconds to RMSE 0.02 / 0.01 / 0.005, interpolated in log-log
 #     between the renders that bracket it (a ladder stops once it is below 0.005);
 #   - an equal-time pair of images: tracer at 64 spp and Cycles at the spp that takes it as long,
-#     both tone-mapped as tracer's PNG (docs/bench/cycles-SCENE-{tracer,cycles}.png).
+#     both tone-mapped as tracer's PNG (docs/bench/cycles-SCENE-{tracer,cycles}.png);
+#   - then tracer with --denoise on the same scenes (scripts/benchmarks-denoise.sh; DENOISE=0: not).
 # Never part of CI or the quick start: Blender is a benchmark-only dependency.
 #   scripts/benchmarks-cycles.sh [--install] [SCENE ...]
 #       --install: apt-get install Debian's blender first (Cycles with Embree inside)
@@ -167,3 +168,9 @@ for name in "${scenes[@]}"; do
     { echo "benchmarks-cycles: $name: the references' means differ by more than 1 %: $means" >&2; exit 1; }
   unset ref_time fixed adaptive thresholds
 done
+
+# tracer with --denoise in the same run (the same machine state as Cycles' ladders above):
+# scripts/benchmarks-denoise.sh on the same scenes, size and threads (DENOISE=0 leaves it out).
+if [[ ${DENOISE:-1} != 0 ]]; then
+  SIZE=$size THREADS=$threads "$(dirname "$0")/benchmarks-denoise.sh" "${scenes[@]}"
+fi

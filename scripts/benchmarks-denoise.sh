@@ -12,7 +12,10 @@
 # (docs/bench/cycles-SCENE.md) these compare with.
 #   scripts/benchmarks-denoise.sh [SCENE ...]     cornell-original cornell-water sponza-sky
 #   SIZE=512 THREADS=2 REF_SPP=4096 MAX_SPP=256   the defaults (sponza-sky: SIZE=256)
-# Writes docs/bench/denoise-SCENE.md. About 12 minutes for each Cornell box on 2 cores.
+#   PAIR_SPP=8                                    the equal-time pair's denoised spp
+# Writes docs/bench/denoise-SCENE.md and an equal-time pair of PNGs, denoise-SCENE-denoised.png
+# (PAIR_SPP, --denoise) and denoise-SCENE-noisy.png (without, the spp that takes as long).
+# About 12 minutes for each Cornell box on 2 cores.
 source "$(dirname "$0")/bench-prelude.sh"
 threads=${THREADS:-2} ref_spp=${REF_SPP:-4096} max_spp=${MAX_SPP:-256}
 exposure=1.5
@@ -71,6 +74,16 @@ for name in "${scenes[@]}"; do
     awk -v e="$e" 'BEGIN { exit !(e < 0.004) }' && break
     awk -v w="$wall" -v r="$ref_wall" 'BEGIN { exit !(w > 0.5 * r) }' && break
   done
+  # The equal-time pair: --denoise at PAIR_SPP, and without at the spp the noisy ladder's longest
+  # render says takes as long.
+  pair_spp=${PAIR_SPP:-8}
+  read -r pair_denoised _ <<<"$(render "$work/pair-d.exr" --spp "$pair_spp" --noise-threshold 0 --denoise)"
+  pair_noisy_spp=$(tail -n 1 <<<"$(printf '%s\n' "${noisy[@]}")" |
+    awk -v t="$pair_denoised" -v m="$pair_spp" '{ s = int(t * $1 / $2 + 0.5); print (s > m ? s : m) }')
+  read -r pair_noisy _ <<<"$(render "$work/pair-n.exr" --spp "$pair_noisy_spp" --noise-threshold 0)"
+  # The same renders again as PNG (the same seed: the same images, tone-mapped as tracer writes them).
+  render "$O/denoise-$name-denoised.png" --spp "$pair_spp" --noise-threshold 0 --denoise >/dev/null
+  render "$O/denoise-$name-noisy.png" --spp "$pair_noisy_spp" --noise-threshold 0 >/dev/null
   {
     echo "$name, ${size}x${size}, path, $threads threads, whole-process wall seconds ($($T --version | head -1))."
     echo "RMSE of the display values (exposure $exposure) against tracer's own $ref_spp-spp reference (seed 99,"
@@ -99,5 +112,9 @@ for name in "${scenes[@]}"; do
     echo "|---:|---:|---:|---:|"
     targets=(0.02 0.01 0.005)
     for i in 0 1 2; do echo "| ${targets[$i]} | ${tn[$i]} | ${td[$i]} | ${ta[$i]} |"; done
+    echo
+    echo "Equal time: denoise-$name-denoised.png, $pair_spp spp with --denoise, $pair_denoised s, RMSE" \
+      "$(rmse "$work/ref.exr" "$work/pair-d.exr"); denoise-$name-noisy.png, $pair_noisy_spp spp without," \
+      "$pair_noisy s, RMSE $(rmse "$work/ref.exr" "$work/pair-n.exr")."
   } | tee "$O/denoise-$name.md"
 done
