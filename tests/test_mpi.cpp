@@ -424,6 +424,18 @@ TEST_F(MpiRender, ARankWithOtherFlagsOrSettingsEndsTheJobWithOneError) {
   }
 }
 
+// User and system CPU seconds process `pid` has used (0 if it is gone).
+double cpu_seconds(pid_t pid) {
+  std::istringstream stat(read_file("/proc/" + std::to_string(pid) + "/stat"));
+  std::string field;
+  double ticks = 0.0;
+  // Fields 14 and 15 (utime, stime); the second field (comm) has no spaces here: "(tracer-mpi)".
+  for (int i = 1; i <= 15 && stat >> field; ++i) {
+    if (i >= 14) ticks += std::atof(field.c_str());
+  }
+  return ticks / double(sysconf(_SC_CLK_TCK));
+}
+
 // Stops rank `rank` of a running job with SIGSTOP once it renders, waits until rank 0 has written
 // `image`, then continues and kills it; returns the job's exit code and output.
 // With `resume_after` > 0 the rank is continued after that many seconds instead (a straggler).
@@ -438,7 +450,12 @@ test::CommandResult stall_one_rank(const std::string& command, const std::string
     if (pids.size() == 1) victim = pids[0];
   }
   if (victim > 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // loaded, built, into the render
+    // Into the render: once the rank has used a quarter second of CPU (MPI's start-up waits in
+    // usleep, and took seconds in a fresh Debian root, so a fixed delay stopped ranks still in
+    // MPI_Init), and at least a second after it appeared.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    for (int i = 0; i < 600 && cpu_seconds(victim) < 0.25; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
     ::kill(victim, SIGSTOP);
     if (resume_after > 0) {
       std::this_thread::sleep_for(std::chrono::duration<double>(resume_after));
