@@ -231,6 +231,16 @@ TEST(Gltf, HostileFilesFailWithOneLineNamingTheFile) {
         {"instances that expand without bound", g, "t.gltf: its instances expand to more than 33554432 triangles"});
   }
   {
+    // The same with no mesh below the root: no triangles to count, but 2^40 nodes to walk.
+    TinyGltf g;
+    g.node = R"({"mesh": 0, "children": [1, 1]})";
+    for (int i = 1; i < 40; ++i)
+      g.extra_nodes += ", {\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
+    g.extra_nodes += R"(, {})";
+    cases.push_back(
+        {"empty nodes that expand without bound", g, "t.gltf: its nodes expand to more than 16777216 instances"});
+  }
+  {
     TinyGltf g;
     g.node = R"({"mesh": 5})";
     cases.push_back({"a mesh that does not exist", g, "t.gltf: mesh 5 does not exist (the file has 1)"});

@@ -31,6 +31,8 @@ namespace tg = tinygltf;
 constexpr uint64_t kMaxTriangles = uint64_t(1) << 25;
 // Deeper node trees than this are refused (real files nest a few dozen levels).
 constexpr int kMaxNodeDepth = 256;
+// Node instances (a node once for each path that reaches it) the expansion may visit.
+constexpr uint64_t kMaxNodeVisits = uint64_t(1) << 24;
 
 // The document's nodes walked from the chosen scene's roots: meshes placed by their transforms,
 // cameras and point lights; materials through gltf::Materials.
@@ -72,6 +74,12 @@ class GltfScene {
     if (total > kMaxTriangles) {
       throw error("its instances expand to more than " + std::to_string(kMaxTriangles) +
                   " triangles, more than tracer loads");
+    }
+    // Nodes without meshes cost no memory but a visit each: a tree of them reached along 2^40
+    // paths would take hours to walk (found by fuzz_gltf).
+    if (all.nodes > kMaxNodeVisits) {
+      throw error("its nodes expand to more than " + std::to_string(kMaxNodeVisits) +
+                  " instances, more than tracer walks");
     }
     // Reserved once: grown by doubling, the arrays would take up to twice the estimate.
     scene_.triangles.reserve(total);
@@ -156,10 +164,11 @@ class GltfScene {
   // What node `index` and its descendants place: triangles and primitives (each a geometry of
   // the scene). Memoised, saturating at kSaturated.
   struct Placed {
-    uint64_t triangles = 0, primitives = 0;
+    uint64_t triangles = 0, primitives = 0, nodes = 0;  // nodes: visits of the expansion
     void add(const Placed& o) {
       triangles = std::min(triangles + o.triangles, kSaturated);
       primitives = std::min(primitives + o.primitives, kSaturated);
+      nodes = std::min(nodes + o.nodes, kSaturated);
     }
   };
   bool uses_default_material() const {
@@ -335,6 +344,7 @@ class GltfScene {
     state = kCounting;
     const tg::Node& node = model_.nodes[size_t(index)];
     Placed sum;
+    sum.nodes = 1;
     if (node.mesh >= 0 && size_t(node.mesh) < model_.meshes.size()) {
       sum.triangles = mesh_triangles(node.mesh);
       sum.primitives = model_.meshes[size_t(node.mesh)].primitives.size();
