@@ -93,7 +93,8 @@ std::vector<Planes> regress(const Context& cx, const Planes& image, const Planes
                             const Planes& features, int patch, int radius, std::span<const float> ks,
                             bool position = true) {
   const int w = image.width(), h = image.height(), bandwidths = int(ks.size());
-  std::vector<Planes> out(ks.size(), Planes(w, h, 3));
+  std::vector<Planes> out;
+  for (size_t b = 0; b < ks.size(); ++b) out.emplace_back(w, h, 3);
   const int edge = 2 * radius + 1, offsets = edge * edge;
   for_tiles(w, h, cx.executor, cx.cancel, [&](int x0, int y0) {
     // The tile's distances for every offset first, then the sums row by row, so that a row's

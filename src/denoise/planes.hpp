@@ -3,7 +3,6 @@
 // the border reads as zero, and the `valid` plane says which pixels are the image's.
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 
 #include "base/huge_pages.hpp"
@@ -35,10 +34,8 @@ class Planes {
         data_(size_, kZeroFilled) {}
   Planes(Planes&&) noexcept = default;
   Planes& operator=(Planes&&) noexcept = default;
-  Planes(const Planes& o) : Planes(o.width_, o.height_, o.channels_) {
-    std::copy(o.data_.get(), o.data_.get() + size_, data_.get());
-  }
-  Planes& operator=(const Planes& o) { return *this = Planes(o); }
+  Planes(const Planes&) = delete;  // hundreds of MB: moved, never copied
+  Planes& operator=(const Planes&) = delete;
 
   int width() const { return width_; }
   int height() const { return height_; }
