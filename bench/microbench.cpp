@@ -272,15 +272,15 @@ void register_incoherent() {
 void register_dynamic() {
   for (SceneCase& c : cases()) {
     for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
-      for (BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
-        static const char* modes[] = {"seq", "async", "queue", "tasks"};
+      for (Strategy mode : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Tbb}) {
         const std::string name = std::string("BM_BvhBuild/") + c.name + "/" +
-                                 (split == BvhSplit::Sah ? "sah/" : "median/") + modes[int(mode)];
+                                 (split == BvhSplit::Sah ? "sah/" : "median/") +
+                                 std::string(name_of<Strategy>(kStrategyNames, mode));
         benchmark::RegisterBenchmark(name.c_str(),
                                      [&c, split, mode](benchmark::State& st) {
                                        BvhBuildOptions o;
                                        o.split = split;
-                                       o.mode = mode;
+                                       o.strategy = mode;
                                        size_t bytes = 0;
                                        for (auto _ : st) {
                                          const Bvh bvh(*c.scene, o);

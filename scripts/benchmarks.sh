@@ -72,7 +72,7 @@ build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/(Sphere|Wa
   --benchmark_repetitions=5 --benchmark_report_aggregates_only=true 2>/dev/null | tee "$O/build-all.txt"
 # The BVH issue's build target: the Bunny's SAH build against Embree's, twelve repetitions each
 # (single builds on this shared VM vary by several milliseconds; compare minima and medians).
-build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/Bunny/(sah/(seq|tasks)|embree)' \
+build/release/bench/tracer_microbench --benchmark_filter='BM_BvhBuild/Bunny/(sah/(seq|tbb)|embree)' \
   --benchmark_repetitions=12 --benchmark_format=console 2>/dev/null | tee "$O/build-bunny.txt"
 # Incoherent rays on the views, traversal only: bounces and AO rays, single and sorted (section 8).
 build/release/bench/tracer_microbench --benchmark_filter='BM_Incoherent/' --benchmark_repetitions=3 \

@@ -129,7 +129,7 @@ TEST(Adaptive, SamePixelsStopForEverySchedulerThreadCountAndTile) {
   s.noise_threshold = 0.08f;
   const Accelerator acc = build_accelerator(scene, AccelOptions{});
   SchedOptions seq;
-  seq.kind = SchedKind::Seq;
+  seq.strategy = Strategy::Seq;
   const AdaptiveRender reference = render_adaptive(scene, acc, seq, s);
   // The rule did something to test: some blocks stopped early, some took every sample.
   const auto [fewest, most] = std::minmax_element(reference.samples.begin(), reference.samples.end());
@@ -139,16 +139,16 @@ TEST(Adaptive, SamePixelsStopForEverySchedulerThreadCountAndTile) {
   uint64_t taken = 0;
   for (const uint32_t n : reference.samples) taken += n;
   EXPECT_EQ(reference.primary, taken);
-  for (SchedKind kind : {SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
+  for (Strategy kind : {Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
     SchedOptions so;
-    so.kind = kind;
+    so.strategy = kind;
     so.threads = 3;
     so.tile = 5;
     so.block = 17;
     const AdaptiveRender r = render_adaptive(scene, acc, so, s);
-    EXPECT_EQ(r.samples, reference.samples) << name_of<SchedKind>(kSchedKindNames, kind);
-    EXPECT_EQ(r.sums, reference.sums) << name_of<SchedKind>(kSchedKindNames, kind);
-    EXPECT_EQ(r.halves, reference.halves) << name_of<SchedKind>(kSchedKindNames, kind);
+    EXPECT_EQ(r.samples, reference.samples) << name_of<Strategy>(kStrategyNames, kind);
+    EXPECT_EQ(r.sums, reference.sums) << name_of<Strategy>(kStrategyNames, kind);
+    EXPECT_EQ(r.halves, reference.halves) << name_of<Strategy>(kStrategyNames, kind);
   }
 }
 

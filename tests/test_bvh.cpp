@@ -130,10 +130,10 @@ Image8 render_small(const A& accel, const Scene& scene, int size) {
 std::vector<BvhBuildOptions> all_builds() {
   std::vector<BvhBuildOptions> v;
   for (BvhSplit split : {BvhSplit::Sah, BvhSplit::Median}) {
-    for (BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+    for (Strategy mode : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Tbb}) {
       BvhBuildOptions o;
       o.split = split;
-      o.mode = mode;
+      o.strategy = mode;
       o.threads = 3;  // odd on purpose: more workers than this machine's cores
       v.push_back(o);
     }
@@ -142,8 +142,8 @@ std::vector<BvhBuildOptions> all_builds() {
 }
 
 std::string describe(const BvhBuildOptions& o) {
-  static const char* modes[] = {"seq", "async", "queue", "tasks"};
-  return std::string(o.split == BvhSplit::Sah ? "sah/" : "median/") + modes[int(o.mode)];
+  return std::string(o.split == BvhSplit::Sah ? "sah/" : "median/") +
+         std::string(name_of<Strategy>(kStrategyNames, o.strategy));
 }
 
 void check_scene_against_brute(const Scene& scene, size_t random_count, int image) {
@@ -200,10 +200,10 @@ void expect_parallel_builds_match(const Scene& scene) {
     seq.split = split;
     const Bvh reference(scene, seq);
     ASSERT_EQ(reference.validate(), "");
-    for (BuildMode mode : {BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+    for (Strategy mode : {Strategy::Async, Strategy::Queue, Strategy::Tbb}) {
       for (int threads : {1, 2, 3, 8}) {
         BvhBuildOptions o = seq;
-        o.mode = mode;
+        o.strategy = mode;
         o.threads = threads;
         const Bvh bvh(scene, o);
         SCOPED_TRACE(describe(o) + " threads " + std::to_string(threads));
@@ -322,11 +322,11 @@ TEST(BvhBuild, CancelFlagStopsEveryBuilderAndEmbree) {
   // A set flag makes each builder stop splitting and the constructor throw, whatever the mode.
   const Scene scene = make_cornell_box(20000);
   std::atomic<bool> cancel{true};
-  for (const BuildMode mode : {BuildMode::Seq, BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+  for (const Strategy mode : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Tbb}) {
     for (const AccelKind kind : {AccelKind::Bvh, AccelKind::Bvh8}) {
       AccelOptions o;
       o.kind = kind;
-      o.bvh.mode = mode;
+      o.bvh.strategy = mode;
       o.bvh.cancel = &cancel;
       EXPECT_THROW(build_accelerator(scene, o), Cancelled);
     }

@@ -185,12 +185,12 @@ TEST(Denoise, FirefliesLeaveNoNanOrInfinity) {
 
 TEST(Denoise, SameImageFromEverySchedulerThreadCountAndTile) {
   // Rendered and denoised by different schedulers, threads and tiles: byte for byte the same.
-  const Films base = render_box(48, 8, SchedOptions{SchedKind::Seq, 1, 16, 64});
+  const Films base = render_box(48, 8, SchedOptions{Strategy::Seq, 1, 16, 64});
   const std::vector<Vec3> expect = denoise::nfor(base.features, Executor(Strategy::Seq));
   const std::pair<SchedOptions, Strategy> variants[] = {
-      {SchedOptions{SchedKind::Tbb, 2, 8, 64}, Strategy::Tbb},
-      {SchedOptions{SchedKind::Atomic, 2, 5, 64}, Strategy::Atomic},
-      {SchedOptions{SchedKind::Queue, 2, 16, 7}, Strategy::Queue},
+      {SchedOptions{Strategy::Tbb, 2, 8, 64}, Strategy::Tbb},
+      {SchedOptions{Strategy::Atomic, 2, 5, 64}, Strategy::Atomic},
+      {SchedOptions{Strategy::Queue, 2, 16, 7}, Strategy::Queue},
   };
   for (const auto& [sched, strategy] : variants) {
     const Films f = render_box(48, 8, sched);

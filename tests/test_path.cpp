@@ -21,7 +21,7 @@ Framebuffer render_path(const Scene& scene, const CameraSpec& cam, RenderSetting
   RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
   RenderControl control;
   SchedOptions so;
-  so.kind = SchedKind::Tbb;
+  so.strategy = Strategy::Tbb;
   EXPECT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), so, control));
   return fb;
 }

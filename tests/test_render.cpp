@@ -107,7 +107,7 @@ TEST(Render, CountedTraversalChangesNoPixelAndCountsTheSameEverywhere) {
       const Accelerator acc = build_accelerator(scene, AccelOptions{});
       QueryCounts first;
       std::vector<float> plain;
-      for (const auto& [kind, threads] : {std::pair{SchedKind::Seq, 1}, {SchedKind::Tbb, 2}, {SchedKind::Queue, 3}}) {
+      for (const auto& [kind, threads] : {std::pair{Strategy::Seq, 1}, {Strategy::Tbb, 2}, {Strategy::Queue, 3}}) {
         for (const bool counted : {false, true}) {
           RenderSettings r = s;
           r.count_traversal = counted;
@@ -115,7 +115,7 @@ TEST(Render, CountedTraversalChangesNoPixelAndCountsTheSameEverywhere) {
           RenderContext ctx{&scene, Camera(*scene.camera, r.width, r.height), r, &fb};
           RenderControl control;
           SchedOptions so;
-          so.kind = kind;
+          so.strategy = kind;
           so.threads = threads;
           ASSERT_TRUE(render_round(acc, ctx, sample_passes(r), so, control));
           std::vector<float> sums;

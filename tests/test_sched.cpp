@@ -70,23 +70,23 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
     SCOPED_TRACE(scene.source);
     const Accelerator acc = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     SchedOptions seq;
-    seq.kind = SchedKind::Seq;
+    seq.strategy = Strategy::Seq;
     const Rendered reference = render_with(scene, acc, seq, size);
     EXPECT_EQ(reference.counts.primary, uint64_t(size) * uint64_t(size * 3 / 4 + 1));
-    for (SchedKind kind : {SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
+    for (Strategy kind : {Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
       for (int threads : {1, 2, 3, 8}) {
         for (int tile : {7, 16}) {
           SchedOptions so;
-          so.kind = kind;
+          so.strategy = kind;
           so.threads = threads;
           so.tile = tile;
           so.block = tile * 4;
-          SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)) + " threads " + std::to_string(threads) +
+          SCOPED_TRACE(std::string(name_of<Strategy>(kStrategyNames, kind)) + " threads " + std::to_string(threads) +
                        " tile " + std::to_string(tile));
           const Rendered r = render_with(scene, acc, so, size);
           EXPECT_EQ(r.rgb, reference.rgb);
           EXPECT_EQ(r.counts.total(), reference.counts.total());
-          if (kind == SchedKind::Async) break;  // rows: the tile size does not apply
+          if (kind == Strategy::Async) break;  // rows: the tile size does not apply
         }
       }
     }
@@ -101,21 +101,21 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
   for (const Scene& scene : scenes()) {
     SCOPED_TRACE(scene.source);
     SchedOptions seq;
-    seq.kind = SchedKind::Seq;
+    seq.strategy = Strategy::Seq;
     const Rendered reference =
         render_with(scene, build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh}), seq, size);
     const Accelerator wide = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh8});
     const Accelerator binary = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
-    for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
+    for (Strategy kind : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
       for (const int variant : {0, 1, 2}) {
         const bool packets = variant > 0;
         SchedOptions so;
-        so.kind = kind;
+        so.strategy = kind;
         so.threads = 2;
         so.tile = 7;
         so.block = 30;
         static const char* names[] = {" bvh8 single rays", " bvh8 packets", " bvh bundles"};
-        SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)) + names[variant]);
+        SCOPED_TRACE(std::string(name_of<Strategy>(kStrategyNames, kind)) + names[variant]);
         const Rendered r = render_with(scene, variant == 2 ? binary : wide, so, size, packets);
         EXPECT_EQ(r.rgb, reference.rgb);
         EXPECT_EQ(r.counts.total(), reference.counts.total());
@@ -154,19 +154,19 @@ TEST(Sched, PathImagesIdenticalAcrossSchedulersThreadsTilesAndAccelerators) {
     SCOPED_TRACE(scene.source);
     const Accelerator bvh = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     SchedOptions seq;
-    seq.kind = SchedKind::Seq;
+    seq.strategy = Strategy::Seq;
     const std::vector<float> reference = path_sums(scene, bvh, seq, size);
-    for (SchedKind kind : {SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
+    for (Strategy kind : {Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
       SchedOptions so;
-      so.kind = kind;
+      so.strategy = kind;
       so.threads = 3;
       so.tile = 5;
       so.block = 17;
-      EXPECT_EQ(path_sums(scene, bvh, so, size), reference) << name_of<SchedKind>(kSchedKindNames, kind);
+      EXPECT_EQ(path_sums(scene, bvh, so, size), reference) << name_of<Strategy>(kStrategyNames, kind);
     }
     for (AccelKind kind : {AccelKind::Bvh8, AccelKind::BruteSimd}) {
       SchedOptions so;
-      so.kind = SchedKind::Tbb;
+      so.strategy = Strategy::Tbb;
       so.threads = 2;
       EXPECT_EQ(path_sums(scene, build_accelerator(scene, AccelOptions{.kind = kind}), so, size), reference)
           << name_of<AccelKind>(kAccelKindNames, kind);
@@ -177,8 +177,8 @@ TEST(Sched, PathImagesIdenticalAcrossSchedulersThreadsTilesAndAccelerators) {
 TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
   const Scene scene = make_cornell_box(0);
   const Accelerator acc = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
-  for (SchedKind kind : {SchedKind::Seq, SchedKind::Async, SchedKind::Queue, SchedKind::Atomic, SchedKind::Tbb}) {
-    SCOPED_TRACE(std::string(name_of<SchedKind>(kSchedKindNames, kind)));
+  for (Strategy kind : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
+    SCOPED_TRACE(std::string(name_of<Strategy>(kStrategyNames, kind)));
     RenderSettings s;
     s.width = s.height = 64;
     s.ao_samples = 1;
@@ -192,7 +192,7 @@ TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
       if (++tiles == 3) cancel = true;
     };
     SchedOptions so;
-    so.kind = kind;
+    so.strategy = kind;
     so.threads = 2;
     EXPECT_FALSE(render_image(acc, ctx, so, control));
     EXPECT_LT(control.pixels_done.load(), uint64_t(s.width) * uint64_t(s.height));
@@ -225,11 +225,11 @@ TEST(Sched, EmbreePacketsTraceTheSameRaysAsEmbreeSingleRays) {
 TEST(ParallelForTiles, EveryPixelExactlyOnceWithEveryStrategy) {
   // The loop knows nothing of rendering: count how often each pixel's tile is handed out.
   constexpr int kW = 97, kH = 61;  // not multiples of any tile or block size
-  for (const EnumName<SchedKind>& e : kSchedKindNames) {
+  for (const EnumName<Strategy>& e : kStrategyNames) {
     for (const int threads : {1, 3}) {
       SCOPED_TRACE(std::string(e.name) + " threads " + std::to_string(threads));
       SchedOptions so;
-      so.kind = e.value;
+      so.strategy = e.value;
       so.threads = threads;
       so.tile = 8;
       so.block = 20;

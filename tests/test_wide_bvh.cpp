@@ -297,13 +297,13 @@ TEST_P(WideBvhBudget, SameTreeUnderEveryExecutorAndThreadCount) {
   ASSERT_GT(scene.size(), 100'000u);
   BvhBuildOptions options;
   options.split_budget = GetParam();
-  options.mode = BuildMode::Seq;
+  options.strategy = Strategy::Seq;
   const WideBvh ref(scene, options);
   EXPECT_EQ(ref.validate(), "");
-  for (const BuildMode mode : {BuildMode::Async, BuildMode::Queue, BuildMode::Tasks}) {
+  for (const Strategy mode : {Strategy::Async, Strategy::Queue, Strategy::Tbb}) {
     for (const int threads : {1, 2, 4}) {
       SCOPED_TRACE(testing::Message() << int(mode) << " " << threads);
-      options.mode = mode;
+      options.strategy = mode;
       options.threads = threads;
       const WideBvh w(scene, options);
       ASSERT_EQ(w.nodes().size(), ref.nodes().size());

@@ -18,8 +18,8 @@ struct Variant {
   std::string name;
   AccelKind accel;
   BvhSplit split;
-  BuildMode build;
-  SchedKind sched;
+  Strategy build;
+  Strategy sched;
   std::string description;
   bool study;
   bool packets = false;                         // primary rays in 4x4 packets (bvh8), AO rays in bundles (bvh, bvh8)

@@ -68,7 +68,7 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
     ao.kind = v.accel;
     ao.quality = v.quality;
     ao.bvh.split = v.split;
-    ao.bvh.mode = v.build;
+    ao.bvh.strategy = v.build;
     ao.bvh.threads = job.threads;
     const Accelerator accel = build_accelerator(job.scene, ao);
     RenderSettings rs;
@@ -85,7 +85,7 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
     RenderControl control;
     control.cancel = &stop;
     SchedOptions so;
-    so.kind = v.sched;
+    so.strategy = v.sched;
     so.threads = job.threads;
     const auto t0 = Clock::now();
     bool finished;

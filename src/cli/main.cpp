@@ -59,7 +59,7 @@ int cmd_render(const RenderArgs& args) {
   };
   const FrameSequence frames{args.output,         args.frames,       args.orbit,     args.checkpoint,
                              exr_pixel_for(args), args.save_partial, aovs_for(args), args.denoise};
-  const Executor denoiser(setup.sched.kind, setup.sched.threads);
+  const Executor denoiser(setup.sched.strategy, setup.sched.threads);
   const DriveResult r =
       drive_render(scene, setup.camera, settings, frames,
                    {.holds_image = true, .round_per_pass = true, .cancel = cancel, .denoiser = &denoiser}, round,

@@ -160,7 +160,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                      "render of at least 16 pixel samples per triangle, else medium, and medium in tracer view)");
   app.add_option("--bvh-split", a.split, "BVH split: " + names_of<BvhSplit>(kBvhSplitNames) + " (the study's)")
       ->capture_default_str();
-  app.add_option("--build", a.build, "BVH build: " + names_of<BuildMode>(kBuildModeNames))->capture_default_str();
+  app.add_option("--build-sched", a.build, "how the BVH build forks: seq, async, queue or tbb")->capture_default_str();
   app.add_option("--max-leaf", a.bvh.max_leaf, "SAH BVH: largest leaf (1-16)")->capture_default_str();
   app.add_option("--bins", a.bvh.bins, "SAH BVH: bins per axis (4-32)")->capture_default_str();
   app.add_option("--traversal-cost", a.bvh.traversal_cost,
@@ -176,7 +176,7 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
                "trace rays together: each hit's AO rays as one bundle (bvh, bvh8, embree), primary rays and shadow "
                "rays per 4x4-pixel block (bvh8, embree); same image (default: on where the accelerator can)");
   app.add_flag("--no-packets", a.no_packets, "trace every ray alone (same image, slower)")->excludes("--packets");
-  app.add_option("--sched", a.sched_kind, "scheduler: " + names_of<SchedKind>(kSchedKindNames))->capture_default_str();
+  app.add_option("--sched", a.sched_kind, "scheduler: " + names_of<Strategy>(kStrategyNames))->capture_default_str();
   app.add_option("--threads", a.threads, "worker threads (default: all hardware threads)");
   app.add_option("--tile", a.sched.tile, "tile edge in pixels for the atomic and tbb schedulers")
       ->capture_default_str();

@@ -52,8 +52,8 @@ struct RenderArgs {
   std::optional<std::string> build_quality;  // empty: chosen by the work (default_build_quality)
   bool packets = false, no_packets = false;  // neither: packets where the accelerator can
   std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
-  std::string build{name_of<BuildMode>(kBuildModeNames, BvhBuildOptions{}.mode)};
-  std::string sched_kind{name_of<SchedKind>(kSchedKindNames, SchedOptions{}.kind)};
+  std::string build{name_of<Strategy>(kStrategyNames, BvhBuildOptions{}.strategy)};
+  std::string sched_kind{name_of<Strategy>(kStrategyNames, SchedOptions{}.strategy)};
   // path for a user's render (every material, soft shadows, indirect light); the library's
   // default, and bench's, stays the study's ao.
   std::string integrator{name_of<Integrator>(kIntegratorNames, Integrator::Path)};

@@ -105,7 +105,9 @@ AccelOptions accel_options_for(const RenderArgs& a) {
     throw UsageError("--simd off: simd-brute is the SIMD brute force; use --accel brute for the scalar one");
   }
   o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
-  o.bvh.mode = parse_name<BuildMode>(kBuildModeNames, a.build, "--build", "builder");
+  o.bvh.strategy = parse_name<Strategy>(kStrategyNames, a.build, "--build-sched", "strategy");
+  if (o.bvh.strategy == Strategy::Atomic)
+    throw UsageError("--build-sched: atomic hands out tiles; a build forks with seq, async, queue or tbb");
   o.bvh.threads = a.threads.value_or(0);
   if (a.build_quality) {
     o.quality = parse_name<BuildQuality>(kBuildQualityNames, *a.build_quality, "--build-quality", "quality");
@@ -126,7 +128,7 @@ BuildQuality default_build_quality(const RenderSettings& s, int frames, size_t t
 
 SchedOptions sched_options_for(const RenderArgs& a) {
   SchedOptions o = a.sched;
-  o.kind = parse_name<SchedKind>(kSchedKindNames, a.sched_kind, "--sched", "scheduler");
+  o.strategy = parse_name<Strategy>(kStrategyNames, a.sched_kind, "--sched", "scheduler");
   o.threads = a.threads.value_or(0);
   return o;
 }

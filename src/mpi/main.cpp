@@ -60,7 +60,7 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const driver::FrameSequence frames{
       args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args), false, {}, args.denoise};
   // Rank 0 denoises the gathered film with its own threads.
-  const Executor denoiser(prepared.sched.kind, prepared.sched.threads);
+  const Executor denoiser(prepared.sched.strategy, prepared.sched.threads);
   const driver::DriveResult driven = driver::drive_render(
       prepared.scene, prepared.camera, prepared.settings, frames,
       // Adaptive sampling decides between passes, from rank 0's image: a round per pass.

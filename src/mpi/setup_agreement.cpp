@@ -50,8 +50,8 @@ std::string settings_fingerprint(const driver::PreparedRender& s, const driver::
     << "\n--focus-distance " << Camera(s.camera, r.width, r.height).focus_distance() << "\n--exposure " << r.exposure
     << "\n--noise-threshold " << r.noise_threshold << "\n--min-spp " << r.min_spp << "\n--frames " << args.frames
     << "\n--orbit " << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--denoise "
-    << (args.denoise ? "on" : "off") << "\n--sched " << name_of<SchedKind>(kSchedKindNames, s.sched.kind) << "\n--tile "
-    << s.sched.tile << "\n--block " << s.sched.block << "\n";
+    << (args.denoise ? "on" : "off") << "\n--sched " << name_of<Strategy>(kStrategyNames, s.sched.strategy)
+    << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block << "\n";
   return f.str();
 }
 

@@ -15,14 +15,14 @@ std::vector<Tile> make_tiles(int width, int height, int tile_w, int tile_h) {
 }
 
 std::vector<Tile> tiles_for(int width, int height, const SchedOptions& o) {
-  switch (o.kind) {
-    case SchedKind::Seq:
-    case SchedKind::Async:
+  switch (o.strategy) {
+    case Strategy::Seq:
+    case Strategy::Async:
       return make_tiles(width, height, width, 1);
-    case SchedKind::Queue:
+    case Strategy::Queue:
       return make_tiles(width, height, o.block, 1);
-    case SchedKind::Atomic:
-    case SchedKind::Tbb:
+    case Strategy::Atomic:
+    case Strategy::Tbb:
       break;
   }
   return make_tiles(width, height, o.tile, o.tile);
@@ -31,7 +31,7 @@ std::vector<Tile> tiles_for(int width, int height, const SchedOptions& o) {
 bool parallel_for_tiles(int width, int height, const SchedOptions& options, CancelFlag cancel,
                         const std::function<void(const Tile&)>& fn) {
   const std::vector<Tile> tiles = tiles_for(width, height, options);
-  return Executor(options.kind, options.threads)
+  return Executor(options.strategy, options.threads)
       .for_each(
           tiles.size(), [&](size_t i) { fn(tiles[i]); }, cancel);
 }

@@ -14,17 +14,15 @@ namespace tracer {
 
 // The tile schedulers are the executor's strategies: seq and async hand out image rows, queue
 // row blocks of `block` pixels, atomic and tbb `tile`-edged squares.
-using SchedKind = Strategy;
-inline constexpr const auto& kSchedKindNames = kStrategyNames;
 
 struct SchedOptions {
-  SchedKind kind = SchedKind::Tbb;
+  Strategy strategy = Strategy::Tbb;
   int threads = 0;  // 0: every hardware thread the process may use
   int tile = 16;    // square tile edge for atomic and tbb
   int block = 64;   // pixels per row block for queue
 };
 
-// The tiles `options.kind` hands out for a width x height image: rows (seq, async), row blocks of
+// The tiles `options.strategy` hands out for a width x height image: rows (seq, async), row blocks of
 // `block` pixels (queue) or `tile`-edged squares (atomic, tbb). The one place tiles are made.
 std::vector<Tile> tiles_for(int width, int height, const SchedOptions& options);
 
@@ -36,7 +34,7 @@ bool parallel_for_tiles(int width, int height, const SchedOptions& options, Canc
 
 // How many threads `options` runs (1 for seq).
 inline int thread_count(const SchedOptions& options) {
-  return options.kind == SchedKind::Seq ? 1 : resolve_thread_count(options.threads);
+  return options.strategy == Strategy::Seq ? 1 : resolve_thread_count(options.threads);
 }
 
 }  // namespace tracer

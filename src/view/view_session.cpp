@@ -52,7 +52,7 @@ ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const dri
       args_(args),
       noise_threshold_(args.noise_threshold),
       min_spp_(args.min_spp),
-      denoiser_(sched_.kind, sched_.threads) {
+      denoiser_(sched_.strategy, sched_.threads) {
   args_.denoise = denoise_ && args_.integrator == name_of<Integrator>(kIntegratorNames, Integrator::Path);
   // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
   // and settings are then derived from those explicit flags, as the command's will be.

@@ -174,22 +174,8 @@ class BvhBuilder {
 
 }  // namespace
 
-Strategy strategy_for(BuildMode mode) {
-  switch (mode) {
-    case BuildMode::Seq:
-      return Strategy::Seq;
-    case BuildMode::Async:
-      return Strategy::Async;
-    case BuildMode::Queue:
-      return Strategy::Queue;
-    case BuildMode::Tasks:
-      break;
-  }
-  return Strategy::Tbb;
-}
-
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options)
-    : Bvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
+    : Bvh(scene, options, Executor(options.strategy, options.threads)) {}
 
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
     : scene_(&scene), options_(options_in) {

@@ -197,7 +197,7 @@ class WideBuilder {
 }  // namespace
 
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
-    : WideBvh(scene, options, Executor(strategy_for(options.mode), options.threads)) {}
+    : WideBvh(scene, options, Executor(options.strategy, options.threads)) {}
 
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
     : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f) {

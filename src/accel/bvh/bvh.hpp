@@ -24,17 +24,14 @@
 namespace tracer {
 
 enum class BvhSplit { Median, Sah };
-enum class BuildMode { Seq, Async, Queue, Tasks };
 inline constexpr EnumName<BvhSplit> kBvhSplitNames[] = {{BvhSplit::Sah, "sah"}, {BvhSplit::Median, "median"}};
-inline constexpr EnumName<BuildMode> kBuildModeNames[] = {
-    {BuildMode::Seq, "seq"}, {BuildMode::Async, "async"}, {BuildMode::Queue, "queue"}, {BuildMode::Tasks, "tasks"}};
 
 struct BvhBuildOptions {
   BvhSplit split = BvhSplit::Sah;
-  BuildMode mode = BuildMode::Tasks;
-  int threads = 0;   // 0: all hardware threads (parallel modes only)
-  int max_leaf = 4;  // SAH: largest leaf; the median split always makes leaves of 1-2
-  int bins = 16;     // SAH bins per axis
+  Strategy strategy = Strategy::Tbb;  // how the build forks (Executor); Atomic forks nothing
+  int threads = 0;                    // 0: all hardware threads (parallel modes only)
+  int max_leaf = 4;                   // SAH: largest leaf; the median split always makes leaves of 1-2
+  int bins = 16;                      // SAH bins per axis
   // Spatial splits may add up to this fraction of references (0: none). The 8-wide BVH only: the
   // binary tree keeps one leaf per triangle.
   float split_budget = 0.0f;
@@ -80,14 +77,11 @@ struct BvhStats {
 
 struct RayBoxTest;
 
-// The executor strategy of a build mode (tasks: oneTBB).
-Strategy strategy_for(BuildMode mode);
-
 class Bvh {
  public:
   static constexpr int kMaxDepth = 96;  // the builder guarantees it; traversal stacks rely on it
 
-  // Builds with the executor `options.mode` names, or the one it is handed.
+  // Builds with the executor `options.strategy` names, or the one it is handed.
   Bvh(const Scene& scene, const BvhBuildOptions& options);
   Bvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
 
