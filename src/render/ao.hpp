@@ -10,8 +10,8 @@
 #include <numbers>
 
 #include "math/rng.hpp"
-#include "parallel/tiles.hpp"
 #include "render/direct_light.hpp"
+#include "render/pixel_samples.hpp"
 
 namespace tracer {
 
@@ -82,51 +82,43 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
   return finish_with_ambient(accel, ctx, x, y, si, direct, counts, sample);
 }
 
-template <class Accel>
-Vec3 shade_pixel(const Accel& accel, const RenderContext& ctx, int x, int y, RayCounts& counts) {
-  const Ray primary = ctx.camera.primary_ray(x, y);
-  ++counts.primary;
-  Hit hit;
-  accel.intersect(primary, hit);
-  return shade_hit(accel, ctx, x, y, primary, hit, counts);
-}
+// The study's workload as the pixel-sample loop (render/pixel_samples.hpp) takes it: a sample's
+// colour, and a 4x4 block's centred samples together -- the primary rays as one packet, then per
+// light the shadow rays as one packet (add_lamp_light's packet form), then each hit's AO rays.
+// Each ray gets the answer it gets alone and every pixel sums its lights in the same order, so a
+// block's colours are those radiance() gives.
+struct AoIntegrator {
+  using Streams = JitterStreams;
+  template <class Accel>
+  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const SampleRng&,
+                RayCounts& counts, FirstHit*, GuideFeatures*) const {
+    Hit hit;
+    accel.intersect(ps.ray, hit);
+    return shade_hit(accel, ctx, ps.x, ps.y, ps.ray, hit, counts, ps.index);
+  }
 
-// A 4x4 pixel block at (bx, by), clipped to the tile: its primary rays as one packet, then per
-// light its shadow rays as one packet (add_lamp_light's packet form), then each hit's AO rays.
-// Each ray gets the answer it gets alone and every pixel sums its lights in the same order, so
-// the image is the one shade_pixel() makes.
-template <class Accel>
-void shade_block(const Accel& accel, const RenderContext& ctx, const Tile& tile, int bx, int by, RayCounts& counts) {
-  RayPacket packet;
-  Ray rays[kPacketSize];
-  for (int k = 0; k < kPacketSize; ++k) {
-    const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-    if (x >= tile.x1 || y >= tile.y1) continue;
-    rays[k] = ctx.camera.primary_ray(x, y);
-    packet.set(k, rays[k]);
-  }
-  Hit hits[kPacketSize];
-  accel.intersect_packet(packet, hits);
-  counts.primary += uint64_t(std::popcount(packet.active));
-  SurfaceInteraction sis[kPacketSize];
-  uint32_t lit = 0;  // lanes that hit something
-  for (uint32_t bits = packet.active; bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
-    if (!hits[k].valid()) {
-      ctx.framebuffer->add(bx + k % kPacketEdge, by + k / kPacketEdge, Vec3{0.0f});
-      continue;
+  template <class Accel>
+  requires PacketAccelerator<Accel>
+  void block_radiance(const Accel& accel, const RenderContext& ctx, const PixelBlock& block, Vec3* radiance,
+                      RayCounts& counts) const {
+    Hit hits[kPacketSize];
+    accel.intersect_packet(block.packet, hits);
+    SurfaceInteraction sis[kPacketSize];
+    uint32_t lit = 0;  // lanes that hit something
+    for (uint32_t bits = block.packet.active; bits; bits &= bits - 1) {
+      const int k = std::countr_zero(bits);
+      radiance[k] = Vec3{0.0f};
+      if (!hits[k].valid()) continue;
+      sis[k] = surface_interaction(ctx, block.rays[k], hits[k]);
+      radiance[k] = sis[k].mat->ke;
+      lit |= 1u << k;
     }
-    sis[k] = surface_interaction(ctx, rays[k], hits[k]);
-    lit |= 1u << k;
+    add_lamp_light(accel, ctx, sis, lit, radiance, counts);
+    for (uint32_t bits = lit; bits; bits &= bits - 1) {
+      const int k = std::countr_zero(bits);
+      radiance[k] = finish_with_ambient(accel, ctx, block.x(k), block.y(k), sis[k], radiance[k], counts);
+    }
   }
-  Vec3 direct[kPacketSize];
-  for (uint32_t bits = lit; bits; bits &= bits - 1) direct[__builtin_ctz(bits)] = sis[__builtin_ctz(bits)].mat->ke;
-  add_lamp_light(accel, ctx, sis, lit, direct, counts);
-  for (uint32_t bits = lit; bits; bits &= bits - 1) {
-    const int k = __builtin_ctz(bits);
-    const int x = bx + k % kPacketEdge, y = by + k / kPacketEdge;
-    ctx.framebuffer->add(x, y, finish_with_ambient(accel, ctx, x, y, sis[k], direct[k], counts));
-  }
-}
+};
 
 }  // namespace tracer

@@ -13,8 +13,8 @@
 
 #include "math/rng.hpp"
 #include "math/sobol.hpp"
-#include "parallel/tiles.hpp"
 #include "render/direct_light.hpp"
+#include "render/pixel_samples.hpp"
 #include "render/texture_lookup.hpp"
 #include "shade/material_bsdf.hpp"
 
@@ -27,27 +27,10 @@ namespace tracer {
 // a choice that has one outcome (one light, one lobe) draws no dimension, as each costs a hash.
 // The light's numbers are drawn before the bounce's ray is traced (see path_radiance), so also
 // for a ray that escapes or meets glass or a mirror, where they go unused.
-inline constexpr uint32_t kPixelSet = 0;
-#ifdef TRACER_INDEPENDENT_SAMPLES
-using PathSampler = SampleRng;  // the baseline scripts/benchmarks-sampler.sh measures against
-#else
-using PathSampler = PixelSampler;
-#endif
 constexpr uint32_t light_set(int depth) { return 1 + 3 * uint32_t(depth); }
 constexpr uint32_t bsdf_set(int depth) { return 2 + 3 * uint32_t(depth); }
 constexpr uint32_t roulette_set(int depth) { return 3 + 3 * uint32_t(depth); }
 inline constexpr int kRouletteDepth = 3;  // bounces kept unconditionally
-// The lens point of a thin-lens camera: a set of its own, beyond every bounce's (--max-depth is at
-// most 64), drawn only when the camera has a lens, so a pinhole's samples are unchanged.
-inline constexpr uint32_t kLensSet = 1u << 16;
-
-// What the camera ray hits first, for the --aov layers: its albedo (the diffuse colour, plus the
-// specular colour of glossy materials, 1 for mirrors and glass, as Intel's denoiser takes it) and
-// its shading normal; both zero where the ray escapes.
-struct FirstHit {
-  Vec3 albedo{0.0f}, normal{0.0f};
-};
-
 // A 2D sample with the third dimension (a choice with one outcome) at 0.
 inline std::array<float, 3> with_third(std::array<float, 2> u) { return {u[0], u[1], 0.0f}; }
 
@@ -95,15 +78,10 @@ void add_sampled_light(const Accel& accel, const LightSampler& lights, const Sur
   }
 }
 
-// The denoiser's features of a sample (film/feature_film.hpp), as Cycles' denoising features are
-// taken: at the first vertex that is not a mirror or glass, with the albedo times what the
-// specular bounces before it let through, so a reflection is guided by what it reflects. Where
-// the path ends before such a vertex, the last vertex's; zero where the camera ray escapes.
-struct GuideFeatures {
-  Vec3 albedo{0.0f}, normal{0.0f};
-  float distance = 0.0f;  // along the path, camera to the vertex
-};
-
+// The radiance along `ray`. The denoiser's features of the sample (film/feature_film.hpp) go to
+// `guide` as Cycles' denoising features are taken: at the first vertex that is not a mirror or
+// glass, with the albedo times what the specular bounces before it let through, so a reflection
+// is guided by what it reflects; where the path ends before such a vertex, the last vertex's.
 template <class Accel>
 Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PathSampler& sampler, RayCounts& counts,
                    FirstHit* first = nullptr, GuideFeatures* guide = nullptr) {
@@ -190,47 +168,14 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
   return radiance;
 }
 
-// Adds this pass's samples to every pixel of `tile`: their sum, taken in sample order from zero
-// (see Framebuffer). A sample that comes out non-finite (a float overflow on a degenerate path)
-// adds black rather than poisoning the pixel.
-template <class Accel>
-void path_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile, RayCounts& counts) {
-  const RenderSettings& s = ctx.settings;
-  for (int y = tile.y0; y < tile.y1; ++y) {
-    for (int x = tile.x0; x < tile.x1; ++x) {
-      if (ctx.active && !ctx.active->active(x, y)) continue;
-      const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
-      Vec3 sum{0.0f}, half{0.0f}, albedo{0.0f}, normal{0.0f};
-      FeatureFilm::PixelSums features;
-      const bool aovs = ctx.albedo || ctx.normal;
-      for (uint32_t k = ctx.samples.first, end = ctx.samples.first + ctx.samples.count; k < end; ++k) {
-        const PathSampler sampler(pixel, k, s.seed);
-        const std::array<float, 2> pu = sampler.get<2>(kPixelSet);
-        Ray ray;
-        if (ctx.camera.thin_lens()) {
-          const std::array<float, 2> lens = sampler.get<2>(kLensSet);
-          ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1], lens[0], lens[1]);
-        } else {
-          ray = ctx.camera.ray_through(float(x) + pu[0], float(y) + pu[1]);
-        }
-        ++counts.primary;
-        FirstHit first;
-        GuideFeatures guide;
-        Vec3 l =
-            path_radiance(accel, ctx, ray, sampler, counts, aovs ? &first : nullptr, ctx.features ? &guide : nullptr);
-        if (!is_finite(l)) l = Vec3{0.0f};
-        sum += l;
-        if (in_half(k)) half += l;
-        albedo += first.albedo;
-        normal += first.normal;
-        if (ctx.features) features.add({l, guide.albedo, guide.normal, guide.distance}, in_half(k));
-      }
-      ctx.framebuffer->add(x, y, sum, half, ctx.samples.count);
-      if (ctx.albedo) ctx.albedo->add(x, y, albedo, ctx.samples.count);
-      if (ctx.normal) ctx.normal->add(x, y, normal, ctx.samples.count);
-      if (ctx.features) ctx.features->add(x, y, features);
-    }
+// Path tracing as the pixel-sample loop (render/pixel_samples.hpp) takes it.
+struct PathIntegrator {
+  using Streams = PathStreams;
+  template <class Accel>
+  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const PathSampler& sampler,
+                RayCounts& counts, FirstHit* first, GuideFeatures* guide) const {
+    return path_radiance(accel, ctx, ps.ray, sampler, counts, first, guide);
   }
-}
+};
 
 }  // namespace tracer

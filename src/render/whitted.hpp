@@ -3,6 +3,7 @@
 #pragma once
 
 #include "render/direct_light.hpp"
+#include "render/pixel_samples.hpp"
 #include "render/texture_lookup.hpp"
 #include "shade/optics.hpp"
 
@@ -61,5 +62,15 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
   si.albedo_over_pi = kd * std::numbers::inv_pi_v<float>;
   return add_lamp_light(accel, ctx, si, emitted, counts) + kd * ctx.settings.ambient;
 }
+
+// Whitted ray tracing as the pixel-sample loop (render/pixel_samples.hpp) takes it.
+struct WhittedIntegrator {
+  using Streams = JitterStreams;
+  template <class Accel>
+  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const SampleRng&,
+                RayCounts& counts, FirstHit*, GuideFeatures*) const {
+    return whitted_radiance(accel, ctx, ps.ray, 0, counts);
+  }
+};
 
 }  // namespace tracer
