@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "driver/render_options.hpp"
+#include "driver/settings_table.hpp"
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
@@ -43,8 +44,7 @@ class ViewServerTest : public ::testing::Test {
     args_.spp = 4;
     args_.threads = 2;
     accel_ = build_accelerator(scene_, driver::accel_options_for(args_));
-    session_ = std::make_unique<view::ViewSession>(scene_, accel_, args_, std::vector<std::string>{"--threads", "2"},
-                                                   view::kViewerFlags);
+    session_ = std::make_unique<view::ViewSession>(scene_, accel_, args_);
     server_ = std::make_unique<view::ViewServer>(*session_, "0123456789abcdef0123456789abcdef");
     port_ = server_->bind("127.0.0.1", 0);
     session_->start();
@@ -113,22 +113,22 @@ TEST_F(ViewServerTest, EveryRequestNeedsTheToken) {
 TEST_F(ViewServerTest, BadChangesAreRefusedWithAMessageAndChangeNothing) {
   const json before = session_->state();
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {R"({"width": 0})", "width: 0 is outside [1, 4096]"},
-      {R"({"height": 5000})", "height: 5000 is outside [1, 4096]"},
+      {R"({"width": 0})", "width: must be between 1 and 16384, got 0"},
+      {R"({"height": 5000})", "height: must be between 1 and 4096, got 5000"},
       {R"({"spp": 2.5})", "spp: expected a whole number"},
       {R"({"spp": "many"})", "spp: expected a number"},
-      {R"({"max_depth": 65})", "max_depth: 65 is outside [0, 64]"},
-      {R"({"exposure": -1})", "exposure: -1 is outside"},
-      {R"({"fov": 180})", "fov: 180 is outside"},
-      {R"({"aperture": -1})", "aperture: -1 is outside"},
-      {R"({"focus_distance": 0})", "focus_distance: 0 is outside"},
+      {R"({"max_depth": 65})", "max_depth: must be between 0 and 64, got 65"},
+      {R"({"exposure": -1})", "exposure: must be above 0"},
+      {R"({"fov": 180})", "fov: must be at least"},
+      {R"({"aperture": -1})", "aperture: must be at least 0"},
+      {R"({"focus_distance": 0})", "focus_distance: must be above 0"},
       {R"({"focus_at": [1]})", "focus_at: expected [x, y]"},
       {R"({"focus_at": [-5, 3]})", "focus_at: -5.000000,3.000000 lies outside the 64x48 image"},
       {R"({"integrator": "raster"})", "integrator: unknown integrator 'raster'"},
       {R"({"eye": [0, 1]})", "eye: expected [x, y, z]"},
       {R"({"eye": [0, 1, 1e300]})", "eye: 1e+300 is outside"},
       {R"({"look": [0, 1, "x"]})", "look: expected a number"},
-      {R"({"up": [0, 0, 0]})", "--up: must not be the zero vector"},
+      {R"({"up": [0, 0, 0]})", "up: must not be the zero vector"},
       {R"({"eye": [1, 1, 1], "look": [1, 1, 1]})", "the camera looks at its own position"},
       {R"({"spp": 8, "colour": 1})", "unknown field 'colour'"},
       {R"([1, 2])", "expected a JSON object"},
@@ -183,7 +183,7 @@ TEST(ViewSession, AdaptiveFlagsFollowTheIntegrator) {
   args.noise_threshold = 0.02;
   args.min_spp = 8;
   const Accelerator accel = build_accelerator(scene, driver::accel_options_for(args));
-  view::ViewSession session(scene, accel, args, {"--noise-threshold", "0.02", "--min-spp", "8"}, view::kViewerFlags);
+  view::ViewSession session(scene, accel, args);
   const std::string launched = session.state()["command"];
   EXPECT_NE(launched.find("--noise-threshold 0.02 --min-spp 8"), std::string::npos) << launched;
   EXPECT_EQ(launched.find("--noise-threshold", launched.find("--noise-threshold") + 1), std::string::npos) << launched;
@@ -359,24 +359,30 @@ TEST_F(ViewServerTest, EventStreamsGetTheNewestFrameEachSeveralAtOnce) {
   }
 }
 
-TEST(ViewCommand, CopiedCommandKeepsTheUsersFlagsAndStatesTheView) {
+// The copied command is the settings table's: every flag whose value differs from a default
+// render's, in the table's order, each float as the shortest text that reads back the same.
+TEST(ViewCommand, CopiedCommandSaysWhatDiffersFromADefaultRender) {
   driver::RenderArgs a;
-  a.eye = "1,2,3";
-  a.look = "0,0,0";
-  a.up = "0,1,0";
-  a.fov = 45.0;
+  a.scene.scene = "my scene.obj";
+  a.scene.lights = {Vec3{0, 1, 0}, Vec3{2, 0.1f, 0}};
+  a.accel = AccelKind::Bvh;
+  a.eye = Vec3{1, 2, 3};
+  a.look = Vec3{0, 0, 0};
+  a.up = Vec3{0, 1, 0};
+  a.fov = 45.3f;
   a.spp = 16;
   a.settings.width = 320;
   a.settings.height = 200;
-  const std::vector<std::string> typed = {
-      "my scene.obj", "--eye",        "9,9,9", "--width=64", "-v1,1,1", "--port", "0",     "--accel",
-      "bvh",          "--listen=::1", "-l",    "2,2,2",      "--light", "0,1,0",  "--spp", "4"};
-  const std::string command = view::render_command(a, typed, view::kViewerFlags);
-  EXPECT_EQ(command,
-            "tracer render 'my scene.obj' --accel bvh --light 0,1,0 --eye 1,2,3 --look 0,0,0 --up 0,1,0 --fov 45 "
-            "--width 320 --height 200 --integrator path --spp 16 --max-depth 8 --exposure 1.5");
-  EXPECT_EQ(view::shell_quote("it's"), "'it'\\''s'");
-  EXPECT_EQ(view::shell_quote(""), "''");
+  a.integrator = Integrator::Ao;
+  a.packets = false;
+  a.threads = 2;
+  EXPECT_EQ(driver::render_command(a),
+            "tracer render --scene 'my scene.obj' --light 0,1,0 --light 2,0.1,0 --width 320 --height 200 "
+            "--eye 1,2,3 --look 0,0,0 --up 0,1,0 --fov 45.3 --integrator ao --spp 16 --accel bvh --no-packets "
+            "--threads 2");
+  EXPECT_EQ(driver::render_command(driver::RenderArgs{}), "tracer render");
+  EXPECT_EQ(driver::shell_quote("it's"), "'it'\\''s'");
+  EXPECT_EQ(driver::shell_quote(""), "''");
 }
 
 // A raw connection to the viewer: what a browser, a script or an attacker sends, byte for byte.

@@ -23,6 +23,7 @@
 #include "driver/render_options.hpp"
 #include "driver/render_stats.hpp"
 #include "driver/scene_setup.hpp"
+#include "driver/settings_table.hpp"
 #include "driver/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
@@ -57,8 +58,8 @@ int cmd_render(const RenderArgs& args) {
   const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
     return render_round(accel, ctx, passes, setup.sched, control);
   };
-  const FrameSequence frames{args.output,         args.frames,       args.orbit,     args.checkpoint,
-                             exr_pixel_for(args), args.save_partial, aovs_for(args), args.denoise};
+  const FrameSequence frames{args.output, args.frames,       args.orbit,     args.checkpoint,
+                             args.exr,    args.save_partial, aovs_for(args), args.denoise};
   const Executor denoiser(setup.sched.strategy, setup.sched.threads);
   const DriveResult r =
       drive_render(scene, setup.camera, settings, frames,
@@ -157,9 +158,9 @@ int main(int argc, char** argv) {
   render->add_flag("--save-partial", render_args.save_partial,
                    "on Ctrl-C, write the image with unfinished tiles black");
 
-  SceneArgs info_args;
+  RenderArgs info_args;
   CLI::App* info = app.add_subcommand("info", "print a scene's triangles, vertices, materials, lights and bounds");
-  add_scene_options(*info, info_args);
+  add_settings(*info, info_args, {SettingGroup::Scene});
 
   std::string compare_a, compare_b;
   CLI::App* compare = app.add_subcommand(
@@ -199,7 +200,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "tracer: error: " << e.what() << " (see tracer --help)\n";
+    // A value refused by its check names the flag and what it takes; CLI11's own errors (an
+    // unknown flag, a missing value) point to the help.
+    const bool value = dynamic_cast<const CLI::ValidationError*>(&e) != nullptr;
+    std::cerr << "tracer: error: " << e.what() << (value ? "\n" : " (see tracer --help)\n");
     return 2;
   }
   try {
@@ -207,12 +211,11 @@ int main(int argc, char** argv) {
     if (view_cmd->parsed()) {
       view_args.width_given = view_cmd->count("--width") > 0;
       view_args.height_given = view_cmd->count("--height") > 0;
-      view_args.user_flags.assign(argv + 2, argv + argc);
       return view::run_view(std::move(view_args));
     }
     // Nothing polls the stop flag in these: a signal ends them at once.
     if (info->parsed() || bench->parsed() || compare->parsed()) install_immediate_stop_handlers(nullptr);
-    if (info->parsed()) return cmd_info(info_args);
+    if (info->parsed()) return cmd_info(info_args.scene);
     if (bench->parsed()) return run_bench(bench_args);
     if (compare->parsed()) return cmd_compare(compare_a, compare_b, compare_exposure);
   } catch (...) {

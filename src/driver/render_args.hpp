@@ -1,6 +1,6 @@
-// The flags of a render (tracer render, bench, view and tracer-mpi): what they are, their
-// defaults, and their check. What they become is render_options.hpp's (settings, accelerator and
-// scheduler options), scene_setup.hpp's (the scene and camera) and prepare_render.hpp's (all of it).
+// The flags of a render (tracer render, view and tracer-mpi) as values. Their names, ranges and
+// help are settings_table.hpp's; what they become is render_options.hpp's (settings, accelerator
+// and scheduler options), scene_setup.hpp's (the scene and camera) and prepare_render.hpp's.
 #pragma once
 
 #include <optional>
@@ -11,6 +11,7 @@
 #include "driver/render_driver.hpp"
 #include "importers/load_limits.hpp"
 #include "io/exr_io.hpp"
+#include "math/vec.hpp"
 #include "render/render_image.hpp"
 
 namespace CLI {
@@ -25,7 +26,7 @@ struct SceneArgs {
   std::string view;   // a view of the views file: its scene, camera and light
   std::string views;  // empty: ../shared/scenes/views.tsv
   int builtin_spheres = 0;
-  std::vector<std::string> lights;
+  std::vector<Vec3> lights;
   bool no_scene_lights = false;
   std::optional<double> light_intensity;
   std::string env_map;        // an equirectangular .exr or .hdr lighting the scene from beyond
@@ -36,34 +37,35 @@ struct SceneArgs {
   std::optional<long long> max_memory_mib;  // --max-memory-mib: empty, the available memory less a margin
 };
 
-// The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,
-// SchedOptions): the flags bind to those structs, and named values start from their tables.
+// --simd: the SIMD kernels where the CPU has them, or scalar code only.
+enum class SimdUse { Auto, Off };
+inline constexpr EnumName<SimdUse> kSimdUseNames[] = {{SimdUse::Auto, "auto"}, {SimdUse::Off, "off"}};
+
+// What a render's flags hold, typed as they are used; settings_table.hpp says each flag's range
+// and help. The defaults are the library's own (RenderSettings, BvhBuildOptions, AccelOptions,
+// SchedOptions): the flags write into those structs.
 struct RenderArgs {
   SceneArgs scene;
-  RenderSettings settings;  // --width --height --ao --ambient --exposure --seed --packets
-  BvhBuildOptions bvh;      // --max-leaf --bins --traversal-cost
-  SchedOptions sched;       // --tile --block
-  std::string eye, look, up;
-  std::optional<double> fov;
+  RenderSettings settings;  // --width --height --ao --ambient --exposure --seed --max-depth ...
+  BvhBuildOptions bvh;      // --max-leaf --bins --traversal-cost --bvh-split --build
+  SchedOptions sched;       // --sched --tile --block
+  std::optional<Vec3> eye, look, up;
+  std::optional<float> fov;
   std::optional<double> aperture;        // --aperture: the lens radius, in scene units
   std::optional<double> focus_distance;  // --focus-distance: default the look-at point's
   std::optional<double> ao_distance;
-  std::optional<std::string> accel;          // empty: the library's default (scalar bvh with --simd off)
-  std::optional<std::string> build_quality;  // empty: chosen by the work (default_build_quality)
-  bool packets = false, no_packets = false;  // neither: packets where the accelerator can
-  std::string split{name_of<BvhSplit>(kBvhSplitNames, BvhBuildOptions{}.split)};
-  std::string build{name_of<Strategy>(kStrategyNames, BvhBuildOptions{}.strategy)};
-  std::string sched_kind{name_of<Strategy>(kStrategyNames, SchedOptions{}.strategy)};
+  std::optional<AccelKind> accel;             // empty: the library's default (scalar bvh with --simd off)
+  std::optional<BuildQuality> build_quality;  // empty: chosen by the work (default_build_quality)
+  std::optional<bool> packets;                // --packets / --no-packets; empty: where the accelerator can
   // path for a user's render (every material, soft shadows, indirect light); the library's
   // default, and bench's, stays the study's ao.
-  std::string integrator{name_of<Integrator>(kIntegratorNames, Integrator::Path)};
-  std::string simd = "auto";
-  std::string exr{name_of<ExrPixel>(kExrPixelNames, ExrPixel::Half)};
-  std::string simd_target{name_of<SimdTarget>(kSimdTargetNames, SimdTarget::Auto)};
-  std::string light_sampling{name_of<LightSampling>(kLightSamplingNames, RenderSettings{}.light_sampling)};
-  std::optional<int> spp;                 // path: samples per pixel (default kDefaultPathSpp)
-  std::string env;                        // path: uniform environment radiance r,g,b
-  std::string aov;                        // path: albedo,normal layers in the EXR
+  Integrator integrator = Integrator::Path;
+  SimdUse simd = SimdUse::Auto;
+  ExrPixel exr = ExrPixel::Half;
+  SimdTarget simd_target = SimdTarget::Auto;
+  std::optional<int> spp;                 // samples per pixel (default kDefaultPathSpp for path, else 1)
+  std::optional<Vec3> env;                // path, whitted: uniform environment radiance
+  std::string aov;                        // path: albedo,normal,... layers in the EXR
   std::optional<double> checkpoint;       // path: seconds between rewrites of the output
   std::optional<double> noise_threshold;  // path: adaptive sampling's (default kDefaultNoiseThreshold)
   std::optional<int> min_spp;             // path: adaptive sampling's minimum samples per pixel
@@ -77,9 +79,9 @@ struct RenderArgs {
   std::string stats_json;
 };
 
-void add_scene_options(CLI::App& app, SceneArgs& args);
 // A file-name option that refuses an empty name (`--stats-json ''` silently wrote nothing).
 CLI::Option* file_option(CLI::Option* option);
+// The flags of settings_table.hpp that a render reads (every row).
 void add_render_options(CLI::App& app, RenderArgs& args);
 // -o/--output, --stats, --stats-json and -q/--quiet, as tracer render and tracer-mpi render share
 // them; `writer` says who writes the files (e.g. " (written by rank 0)"), `stats` what --stats prints.

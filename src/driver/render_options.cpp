@@ -9,33 +9,20 @@ namespace tracer::driver {
 RenderSettings settings_for(const RenderArgs& a) {
   RenderSettings s = a.settings;
   if (a.ao_distance) s.ao_distance = float(*a.ao_distance);
-  s.integrator = parse_name<Integrator>(kIntegratorNames, a.integrator, "--integrator", "integrator");
-  s.light_sampling =
-      parse_name<LightSampling>(kLightSamplingNames, a.light_sampling, "--light-sampling", "light sampling");
+  s.integrator = a.integrator;
   const bool path = s.integrator == Integrator::Path;
-  if (a.checkpoint && !path) throw UsageError("--checkpoint: only for --integrator path");
-  if (a.noise_threshold && !path) throw UsageError("--noise-threshold: only for --integrator path");
-  if (a.min_spp && !path) throw UsageError("--min-spp: only for --integrator path");
   s.noise_threshold = path ? float(a.noise_threshold.value_or(a.denoise ? 0.0 : kDefaultNoiseThreshold)) : 0.0f;
   s.min_spp = a.min_spp.value_or(s.min_spp);
-  for (const auto& [flag, given] : {std::pair{"--env", !a.env.empty()}, {"--env-map", !a.scene.env_map.empty()}}) {
-    if (given && s.integrator == Integrator::Ao)
-      throw UsageError(std::string(flag) + ": only for --integrator path or whitted");
-  }
   // Every integrator anti-aliases with --spp; ao and whitted take one centred sample by default.
   s.spp = a.spp.value_or(path ? kDefaultPathSpp : 1);
-  if (!a.env.empty())
-    s.environment = parse_vec3("--env", a.env);
+  if (a.env)
+    s.environment = *a.env;
   else if (!a.scene.env_map.empty())
     s.environment = Vec3{1.0f};
-  // Packets by default where the accelerator has them, but not under --simd off (all scalar), and
-  // not for whitted, whose rays go one at a time.
-  const bool by_default = s.packets && !a.no_packets && a.simd != "off";
-  s.packets =
-      (a.packets || by_default) && traces_rays_together(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
-  if (a.count && accel_options_for(a).kind != AccelKind::Bvh8) {
-    throw UsageError("--count: only the 8-wide BVH counts its traversal (--accel bvh8, the default)");
-  }
+  // Rays together by default where the accelerator can, but not under --simd off (all scalar),
+  // and not for whitted or path, whose rays go one at a time.
+  const bool together = a.packets.value_or(s.packets && a.simd != SimdUse::Off);
+  s.packets = together && traces_rays_together(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
   s.count_traversal = a.count;
   return s;
 }
@@ -43,7 +30,7 @@ RenderSettings settings_for(const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
   RenderSettings s = settings_for(a);
   note.clear();
-  if (s.integrator == Integrator::Path && a.env.empty() && scene.environment_map.empty() && scene.emitters.empty()) {
+  if (s.integrator == Integrator::Path && !a.env && scene.environment_map.empty() && scene.emitters.empty()) {
     s.environment = Vec3{1.0f};
     note = scene.source +
            " has no emissive surface: a uniform white sky lights it too (--env 1,1,1; --env 0,0,0 for none)";
@@ -82,9 +69,6 @@ Aovs aovs_for(const RenderArgs& a) {
       throw UsageError("--aov: unknown layer '" + name + "' (expected albedo, normal, samples, noisy, variance)");
     }
   }
-  if (a.integrator != name_of<Integrator>(kIntegratorNames, Integrator::Path)) {
-    throw UsageError("--aov: only for --integrator path");
-  }
   if (image_format_for(a.output) != ImageFormat::Exr) throw UsageError("--aov: the layers need an .exr output (-o)");
   return aovs;
 }
@@ -92,28 +76,22 @@ Aovs aovs_for(const RenderArgs& a) {
 AccelOptions accel_options_for(const RenderArgs& a) {
   AccelOptions o;
   o.bvh = a.bvh;
-  const std::string simd = a.simd;
-  if (simd != "auto" && simd != "off") throw UsageError("--simd: expected auto or off, got '" + a.simd + "'");
-
+  const bool scalar = a.simd == SimdUse::Off;
   // --simd off alone asks for the scalar baseline: the binary BVH, not the SIMD default.
-  const AccelKind fallback = simd == "off" ? AccelKind::Bvh : o.kind;
-  o.kind = a.accel ? parse_name<AccelKind>(kAccelKindNames, *a.accel, "--accel", "accelerator") : fallback;
-  if (o.kind == AccelKind::Bvh8 && simd == "off") {
+  o.kind = a.accel.value_or(scalar ? AccelKind::Bvh : o.kind);
+  if (o.kind == AccelKind::Bvh8 && scalar) {
     throw UsageError("--simd off: bvh8 is the SIMD tree; use --accel bvh for scalar traversal");
   }
-  if (o.kind == AccelKind::BruteSimd && simd == "off") {
+  if (o.kind == AccelKind::BruteSimd && scalar) {
     throw UsageError("--simd off: simd-brute is the SIMD brute force; use --accel brute for the scalar one");
   }
-  o.bvh.split = parse_name<BvhSplit>(kBvhSplitNames, a.split, "--bvh-split", "split");
-  o.bvh.strategy = parse_name<Strategy>(kStrategyNames, a.build, "--build-sched", "strategy");
-  if (o.bvh.strategy == Strategy::Atomic)
-    throw UsageError("--build-sched: atomic hands out tiles; a build forks with seq, async, queue or tbb");
   o.bvh.threads = a.threads.value_or(0);
   if (a.build_quality) {
-    o.quality = parse_name<BuildQuality>(kBuildQualityNames, *a.build_quality, "--build-quality", "quality");
+    o.quality = *a.build_quality;
     if (!has_build_quality(o.kind)) throw UsageError("--build-quality: only bvh8 and embree build at a quality level");
     if (o.kind == AccelKind::EmbreeHigh && o.quality != BuildQuality::High) {
-      throw UsageError("--build-quality " + *a.build_quality + ": --accel embree-high is Embree at high");
+      throw UsageError("--build-quality " + std::string(name_of<BuildQuality>(kBuildQualityNames, o.quality)) +
+                       ": --accel embree-high is Embree at high");
     }
   }
   return o;
@@ -128,17 +106,8 @@ BuildQuality default_build_quality(const RenderSettings& s, int frames, size_t t
 
 SchedOptions sched_options_for(const RenderArgs& a) {
   SchedOptions o = a.sched;
-  o.strategy = parse_name<Strategy>(kStrategyNames, a.sched_kind, "--sched", "scheduler");
   o.threads = a.threads.value_or(0);
   return o;
-}
-
-ExrPixel exr_pixel_for(const RenderArgs& a) {
-  return parse_name<ExrPixel>(kExrPixelNames, a.exr, "--exr", "pixel type");
-}
-
-SimdTarget simd_target_for(const RenderArgs& a) {
-  return parse_name<SimdTarget>(kSimdTargetNames, a.simd_target, "--simd-target", "target");
 }
 
 }  // namespace tracer::driver

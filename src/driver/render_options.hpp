@@ -32,8 +32,6 @@ AccelOptions accel_options_for(const RenderArgs& args);
 inline constexpr double kHighQualitySamplesPerTriangle = 16.0;
 BuildQuality default_build_quality(const RenderSettings& settings, int frames, size_t triangles);
 SchedOptions sched_options_for(const RenderArgs& args);
-SimdTarget simd_target_for(const RenderArgs& args);
-ExrPixel exr_pixel_for(const RenderArgs& args);
 // --aov: a comma-separated list of albedo, normal and samples, only for path renders to .exr; throws UsageError.
 Aovs aovs_for(const RenderArgs& args);
 

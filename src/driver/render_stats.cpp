@@ -35,7 +35,7 @@ std::string lighting(const Scene& scene, const RenderSettings& settings, const R
       char text[96];
       std::snprintf(text, sizeof text, "a uniform sky (%g, %g, %g)", double(sky.x), double(sky.y), double(sky.z));
       add(text);
-      if (args.env.empty() && scene.emitters.empty() && scene.environment_map.empty()) {
+      if (!args.env && scene.emitters.empty() && scene.environment_map.empty()) {
         out += " added by tracer: the scene has no emissive surface (--env 0,0,0 for none)";
       }
     }

@@ -29,9 +29,9 @@ void add_lights(Scene& scene, const SceneArgs& a) {
     scene.emitters = Emitters{};
   }
   const float intensity = a.light_intensity ? float(*a.light_intensity) : scene.default_light_intensity();
-  for (const std::string& text : a.lights) {
+  for (const Vec3& position : a.lights) {
     Light l;
-    l.position = parse_point("--light", text);
+    l.position = position;
     l.power = Vec3{intensity};
     scene.lights.push_back(l);
   }
@@ -126,22 +126,21 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
 }
 
 CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
-  const float fov = a.fov ? float(*a.fov) : kDefaultFovDegrees;
+  const float fov = a.fov.value_or(kDefaultFovDegrees);
   const Vec3 extent = scene.bounds.extent();
-  if (a.eye.empty() && a.look.empty() && !scene.camera && std::max({extent.x, extent.y, extent.z}) == 0.0f) {
+  if (!a.eye && !a.look && !scene.camera && std::max({extent.x, extent.y, extent.z}) == 0.0f) {
     throw InputError(scene.source +
                      ": all vertices coincide, so there is nothing to frame (every triangle is degenerate)");
   }
-  CameraSpec spec =
-      scene.camera && a.eye.empty() && a.look.empty() && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
-  if (!a.eye.empty()) {
-    spec.eye = parse_point("--eye", a.eye);
-    if (a.look.empty()) spec.look = scene.bounds.center();
+  CameraSpec spec = scene.camera && !a.eye && !a.look && !a.fov ? *scene.camera : frame_bounds(scene.bounds, fov);
+  if (a.eye) {
+    spec.eye = *a.eye;
+    if (!a.look) spec.look = scene.bounds.center();
   }
-  if (!a.look.empty()) spec.look = parse_point("--look", a.look);
-  if (!a.up.empty()) {
+  if (a.look) spec.look = *a.look;
+  if (a.up) {
     // Scaled first, so a huge but valid --up cannot overflow the cross products below.
-    const Vec3 up = parse_vec3("--up", a.up);
+    const Vec3 up = *a.up;
     spec.up = up * (1.0f / std::max({std::fabs(up.x), std::fabs(up.y), std::fabs(up.z)}));
   }
   // A narrow --fov backs the framed camera off; past kMaxCameraDistance its rays could not reach
@@ -151,7 +150,7 @@ CameraSpec camera_for(const Scene& scene, const RenderArgs& a) {
                      " degrees frames this scene from too far away (beyond 4e12); widen it or give --eye");
   }
   const Vec3 forward = spec.look - spec.eye;
-  if (length(forward) == 0.0f && a.eye.empty() && a.look.empty()) {
+  if (length(forward) == 0.0f && !a.eye && !a.look) {
     // Framed by tracer, not placed by the user: the scene's extent is below what floats resolve.
     char size[32];
     std::snprintf(size, sizeof size, "%g", double(std::max({extent.x, extent.y, extent.z})));

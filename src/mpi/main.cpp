@@ -57,8 +57,8 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const driver::PreparedRender& prepared = *setup.prepared;
   RankRender rank(prepared, args, session, std::move(agreement.threads), rank_timeout, watch_phase);
   // Signals end a rank at once (install_immediate_stop_handlers): no round is ever stopped.
-  const driver::FrameSequence frames{
-      args.output, args.frames, args.orbit, args.checkpoint, driver::exr_pixel_for(args), false, {}, args.denoise};
+  const driver::FrameSequence frames{args.output, args.frames, args.orbit, args.checkpoint,
+                                     args.exr,    false,       {},         args.denoise};
   // Rank 0 denoises the gathered film with its own threads.
   const Executor denoiser(prepared.sched.strategy, prepared.sched.threads);
   const driver::DriveResult driven = driver::drive_render(
@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return session->root() ? app.exit(e) : 0;
-    parse_error = std::string(e.what()) + " (see tracer-mpi --help)";
+    const bool value = dynamic_cast<const CLI::ValidationError*>(&e) != nullptr;  // as tracer's main
+    parse_error = std::string(e.what()) + (value ? "" : " (see tracer-mpi --help)");
   }
   try {
     return mpi::run(args, *session, parse_error, rank_timeout, watch);

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "base/errors.hpp"
+#include "driver/settings_table.hpp"
 #include "parallel/thread_count.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene_checksum.hpp"
@@ -31,27 +32,21 @@ std::pair<std::string, std::string> first_difference(const std::string& ours, co
 }  // namespace
 
 std::string settings_fingerprint(const driver::PreparedRender& s, const driver::RenderArgs& args) {
+  // Every flag that defines the image or cuts the work, as given; then what they resolve to on
+  // this rank (a views file or a glTF camera may differ between nodes).
   std::ostringstream f;
   f.precision(9);
-  const RenderSettings& r = s.settings;
   const auto vec = [](Vec3 v) {
     std::ostringstream o;
     o.precision(9);
     o << v.x << "," << v.y << "," << v.z;
     return o.str();
   };
-  f << "--width " << r.width << "\n--height " << r.height << "\n--integrator "
-    << name_of<Integrator>(kIntegratorNames, r.integrator) << "\n--spp " << r.spp << "\n--max-depth " << r.max_depth
-    << "\n--ao " << r.ao_samples << "\n--ao-distance " << r.ao_distance << "\n--ambient " << r.ambient << "\n--seed "
-    << r.seed << "\n--light-sampling " << name_of<LightSampling>(kLightSamplingNames, r.light_sampling)
-    << "\n--env-map " << args.scene.env_map << "\n--env-rotation " << args.scene.env_rotation << "\n--env "
-    << vec(r.environment) << "\n--eye " << vec(s.camera.eye) << "\n--look " << vec(s.camera.look) << "\n--up "
-    << vec(s.camera.up) << "\n--fov " << s.camera.fov_degrees << "\n--aperture " << s.camera.lens_radius
-    << "\n--focus-distance " << Camera(s.camera, r.width, r.height).focus_distance() << "\n--exposure " << r.exposure
-    << "\n--noise-threshold " << r.noise_threshold << "\n--min-spp " << r.min_spp << "\n--frames " << args.frames
-    << "\n--orbit " << args.orbit << "\n--checkpoint " << (args.checkpoint ? "on" : "off") << "\n--denoise "
-    << (args.denoise ? "on" : "off") << "\n--sched " << name_of<Strategy>(kStrategyNames, s.sched.strategy)
-    << "\n--tile " << s.sched.tile << "\n--block " << s.sched.block << "\n";
+  const RenderSettings& r = s.settings;
+  f << driver::settings_lines(args, {driver::Role::Image, driver::Role::Work}) << "camera " << vec(s.camera.eye) << " "
+    << vec(s.camera.look) << " " << vec(s.camera.up) << " " << s.camera.fov_degrees << " " << s.camera.lens_radius
+    << " " << Camera(s.camera, r.width, r.height).focus_distance() << "\nenvironment " << vec(r.environment)
+    << "\nsamples " << r.spp << " noise threshold " << r.noise_threshold << "\n";
   return f.str();
 }
 

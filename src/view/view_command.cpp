@@ -30,15 +30,17 @@ int run_view(ViewArgs args) {
   if (r.orbit != 0.0) throw UsageError("--orbit: not for tracer view (drag to orbit)");
   if (!r.aov.empty()) throw UsageError("--aov: not for tracer view (tracer render writes the layers)");
   if (r.checkpoint) throw UsageError("--checkpoint: not for tracer view (save downloads the image)");
-  // The first image comes before any gain from a slower build (docs/BENCHMARKS.md section 19).
-  if (!r.build_quality) r.build_quality = "medium";
   check_range("--width", r.settings.width, 1, kMaxViewSide);
   check_range("--height", r.settings.height, 1, kMaxViewSide);
-  const PreparedRender setup(r, {.writes_outputs = false, .quiet = r.quiet, .cancel = cancel});
+  // The first image comes before any gain from a slower build (docs/BENCHMARKS.md section 19);
+  // the copied command leaves the quality to tracer render, as the user did.
+  RenderArgs built = r;
+  if (!built.build_quality) built.build_quality = BuildQuality::Medium;
+  const PreparedRender setup(built, {.writes_outputs = false, .quiet = r.quiet, .cancel = cancel});
   if (!setup.lighting_note.empty() && !r.quiet) std::cerr << "tracer: note: " << setup.lighting_note << "\n";
   const Scene& scene = setup.scene;
 
-  ViewSession session(scene, setup.accel, r, args.user_flags, kViewerFlags);
+  ViewSession session(scene, setup.accel, r);
   ViewServer server(session, random_token());
   const int port = server.bind(args.listen, args.port);
   session.start();

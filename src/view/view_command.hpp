@@ -3,7 +3,6 @@
 #pragma once
 
 #include <string>
-#include <vector>
 
 #include "driver/render_args.hpp"
 
@@ -14,12 +13,7 @@ struct ViewArgs {
   std::string listen = "127.0.0.1";
   int port = 8421;
   bool width_given = false, height_given = false;
-  // The command's arguments after "view", as typed: the copied render command keeps them.
-  std::vector<std::string> user_flags;
 };
-
-// The viewer's own flags, each taking one value (dropped from the copied render command).
-inline const std::vector<std::string> kViewerFlags = {"--listen", "--port"};
 
 // The size the viewer renders when --width/--height are not given: fluid on two cores.
 inline constexpr int kDefaultViewSide = 512;

@@ -10,6 +10,7 @@
 #include "denoise/nfor.hpp"
 #include "driver/render_options.hpp"
 #include "driver/scene_setup.hpp"
+#include "driver/settings_table.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
 
@@ -42,25 +43,21 @@ bool denoised(const driver::RenderArgs& a) {
 
 }  // namespace
 
-ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args,
-                         std::vector<std::string> user_flags, std::vector<std::string> viewer_flags)
+ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args)
     : scene_(scene),
       accel_(accel),
       sched_(driver::sched_options_for(args)),
-      user_flags_(std::move(user_flags)),
-      viewer_flags_(std::move(viewer_flags)),
       args_(args),
-      noise_threshold_(args.noise_threshold),
-      min_spp_(args.min_spp),
+      launched_(args),
       denoiser_(sched_.strategy, sched_.threads) {
-  args_.denoise = denoise_ && args_.integrator == name_of<Integrator>(kIntegratorNames, Integrator::Path);
+  args_.denoise = denoise_ && args_.integrator == Integrator::Path;
   // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
   // and settings are then derived from those explicit flags, as the command's will be.
   const CameraSpec camera = driver::camera_for(scene_, args_);
-  args_.eye = vec_text(camera.eye);
-  args_.look = vec_text(camera.look);
-  args_.up = vec_text(camera.up);
-  args_.fov = double(camera.fov_degrees);
+  args_.eye = camera.eye;
+  args_.look = camera.look;
+  args_.up = camera.up;
+  args_.fov = camera.fov_degrees;
   std::string note;
   const RenderSettings settings = driver::settings_for(args_, scene_, note);
   args_.spp = settings.spp;
@@ -94,14 +91,13 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   {
     const std::lock_guard lock(mu_);
     StateFields fields{args_, denoise_, std::nullopt};
-    read_change(change, fields, noise_threshold_, min_spp_);
+    read_change(change, fields, launched_);
     driver::RenderArgs& a = fields.args;
     const bool denoise = fields.denoise;
     const std::optional<Vec2>& focus_at = fields.focus_at;
     // The toggle is path tracing's: another integrator renders without it, and a switch back
     // takes it again.
-    a.denoise = denoise &&
-                parse_name<Integrator>(kIntegratorNames, a.integrator, "integrator", "integrator") == Integrator::Path;
+    a.denoise = denoise && a.integrator == Integrator::Path;
     // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
     // looking at its own position or along its up vector).
     driver::validate(a);
@@ -118,12 +114,10 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     const RenderSettings settings = driver::settings_for(a, scene_, settings_note);
     exposure_changed = settings.exposure != job_.settings.exposure;
     exposure = settings.exposure;
-    const bool same_view = a.eye == args_.eye && a.look == args_.look && a.up == args_.up && a.fov == args_.fov &&
-                           a.aperture == args_.aperture && a.focus_distance == args_.focus_distance &&
-                           a.integrator == args_.integrator && a.settings.max_depth == args_.settings.max_depth &&
-                           a.settings.width == args_.settings.width && a.settings.height == args_.settings.height &&
-                           a.denoise == args_.denoise &&
-                           // adaptive sampling measures noise at the exposure: another one stops other pixels
+    // The image's flags but the samples and the exposure (a film goes on with more samples; the
+    // exposure tone-maps it) unchanged; adaptive sampling measures noise at the exposure, though,
+    // so another one stops other pixels.
+    const bool same_view = driver::same_settings(a, args_, {driver::Role::Image}, {"--spp", "--exposure"}) &&
                            (!adaptive(settings) || settings.exposure == job_.settings.exposure);
     const bool restart = !same_view || a.spp != args_.spp;
     const bool raised = same_view && *a.spp > *args_.spp;
@@ -175,26 +169,23 @@ nlohmann::json ViewSession::state() const {
 
 nlohmann::json ViewSession::state_locked() const {
   const CameraSpec& c = job_.camera;
-  return {{"generation", generation_},
-          {"eye", vec_json(c.eye)},
-          {"look", vec_json(c.look)},
-          {"up", vec_json(c.up)},
-          {"fov", c.fov_degrees},
-          {"aperture", args_.aperture.value_or(0.0)},  // as the command gives it
-          {"focus_distance", Camera(c, args_.settings.width, args_.settings.height).focus_distance()},
-          {"integrator", args_.integrator},
-          {"spp", *args_.spp},
-          {"max_depth", args_.settings.max_depth},
-          {"exposure", args_.settings.exposure},
-          {"width", args_.settings.width},
-          {"height", args_.settings.height},
-          {"denoise", denoise_},
-          {"max_side", kMaxViewSide},
-          {"command", render_command(args_, user_flags_, viewer_flags_)},
-          {"scene", scene_.source},
-          {"triangles", scene_.size()},
-          {"scene_size", length(scene_.bounds.extent())},
-          {"accel", std::string(name_of<AccelKind>(kAccelKindNames, accel_.kind))}};
+  nlohmann::json state = state_fields(args_);
+  // The camera as rendered, the lens as the command gives it, the focus as it falls.
+  state["eye"] = vec_json(c.eye);
+  state["look"] = vec_json(c.look);
+  state["up"] = vec_json(c.up);
+  state["fov"] = c.fov_degrees;
+  state["aperture"] = args_.aperture.value_or(0.0);
+  state["focus_distance"] = Camera(c, args_.settings.width, args_.settings.height).focus_distance();
+  state["generation"] = generation_;
+  state["denoise"] = denoise_;
+  state["max_side"] = kMaxViewSide;
+  state["command"] = driver::render_command(args_);
+  state["scene"] = scene_.source;
+  state["triangles"] = scene_.size();
+  state["scene_size"] = length(scene_.bounds.extent());
+  state["accel"] = std::string(name_of<AccelKind>(kAccelKindNames, accel_.kind));
+  return state;
 }
 
 std::optional<ViewSession::Snapshot> ViewSession::snapshot() const {

@@ -31,10 +31,9 @@ namespace tracer::view {
 
 class ViewSession {
  public:
-  // `args`: the view command's flags (the state starts from them); `user_flags`: its arguments as
-  // given, for the copied command. The scene and accelerator must outlive the session.
-  ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args,
-              std::vector<std::string> user_flags, std::vector<std::string> viewer_flags);
+  // `args`: the view command's flags (the state starts from them; the copied command says what
+  // differs from a default render). The scene and accelerator must outlive the session.
+  ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args);
   ~ViewSession();
   ViewSession(const ViewSession&) = delete;
   ViewSession& operator=(const ViewSession&) = delete;
@@ -43,8 +42,9 @@ class ViewSession {
   // Interrupts the render and joins its thread; frames() is closed. Idempotent.
   void stop();
 
-  // Applies a change: a JSON object of any of eye, look, up ([x, y, z]), fov, integrator, spp,
-  // max_depth, exposure, width, height, denoise (true or false: path tracing's image denoised
+  // Applies a change: a JSON object of the settings table's viewer fields (eye, look, up as
+  // [x, y, z], fov, aperture, focus_distance, integrator, spp, max_depth, exposure, width, height),
+  // focus_at ([x, y]: focus on the surface at that pixel) and denoise (true or false: path tracing's image denoised
   // once the camera rests; on by default). Throws UsageError naming the field for an unknown field,
   // a wrong type or a bad value; then nothing changes. Returns the new state.
   nlohmann::json apply(const nlohmann::json& change);
@@ -96,16 +96,13 @@ class ViewSession {
   std::optional<float> focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const;
   const Accelerator& accel_;
   const SchedOptions sched_;
-  const std::vector<std::string> user_flags_, viewer_flags_;
 
   // The state, guarded by mu_; a change bumps generation_ and sets interrupt_ under it.
   mutable std::mutex mu_;
   std::condition_variable cv_;
   driver::RenderArgs args_;
-  // Adaptive sampling's flags as launched: path tracing's only, so another integrator renders
-  // without them and a switch back to path tracing takes them again.
-  std::optional<double> noise_threshold_;
-  std::optional<int> min_spp_;
+  // The flags as launched: a switch of integrator takes those of the new one from here.
+  const driver::RenderArgs launched_;
   bool denoise_ = true;  // the page's toggle; applies to path tracing only
   Job job_;
   uint64_t generation_ = 1;

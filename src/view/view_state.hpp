@@ -1,13 +1,11 @@
-// The viewer's state as its page reads and writes it: a JSON change read field by field into the
-// flags of `tracer render` (the same checks follow, in ViewSession::apply), the floats written so
-// they parse back the same, and the `tracer render` command of a state, which the page copies.
+// The viewer's state as its page reads and writes it: the fields are the settings table's rows
+// that have a viewer key (driver/settings_table.hpp), read and checked as the command line's are,
+// plus the page's own (its denoise toggle, a pixel to focus at).
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>
 
 #include <optional>
-#include <string>
-#include <vector>
 
 #include "driver/render_args.hpp"
 #include "math/vec.hpp"
@@ -19,38 +17,6 @@ namespace tracer::view {
 // made, 268 MB at most; the 8-bit image, 50 MB; measured 724 MB), 181 MB at 2048 x 2048.
 inline constexpr int kMaxViewSide = 4096;
 
-// The flags of a `tracer render` command that the viewer's state sets, each taking one value. The
-// viewer's "copy command" drops them from the user's own flags and writes the current ones.
-inline constexpr const char* kStateFlags[] = {"--eye",
-                                              "-v",
-                                              "--look",
-                                              "--up",
-                                              "--fov",
-                                              "--width",
-                                              "--height",
-                                              "--spp",
-                                              "--integrator",
-                                              "--max-depth",
-                                              "--exposure",
-                                              "-l",
-                                              "--aperture",
-                                              "--focus-distance",
-                                              "--noise-threshold",
-                                              "--min-spp"};
-
-// The command line of `tracer render` for `args`: `user_flags` (the view command's own arguments)
-// without the state's flags and the viewer's own (`viewer_flags`, each taking one value), then the
-// state's, every value written so that it parses back to the same float. Shell-quoted.
-std::string render_command(const driver::RenderArgs& args, const std::vector<std::string>& user_flags,
-                           const std::vector<std::string>& viewer_flags);
-
-// Quotes a word for a POSIX shell when it needs it.
-std::string shell_quote(const std::string& word);
-
-// x,y,z of floats, each written so it parses back to the same float; and as a JSON array.
-std::string vec_text(Vec3 v);
-nlohmann::json vec_json(Vec3 v);
-
 // What a change sets: the render flags, the page's denoise toggle, and a pixel to focus at.
 struct StateFields {
   driver::RenderArgs args;
@@ -58,12 +24,15 @@ struct StateFields {
   std::optional<Vec2> focus_at;
 };
 
-// Reads `change` (a JSON object of eye, look, up, fov, aperture, focus_distance, focus_at,
-// integrator, spp, max_depth, exposure, width, height, denoise) into `fields`. A switch of
-// integrator takes adaptive sampling's flags as launched (`noise_threshold`, `min_spp`) for path
-// tracing and none for the others. Throws UsageError naming the field for an unknown field, a
-// wrong type or a value out of range.
-void read_change(const nlohmann::json& change, StateFields& fields, std::optional<double> noise_threshold,
-                 std::optional<int> min_spp);
+// Reads `change` (a JSON object of the table's viewer fields, denoise and focus_at) into `fields`,
+// each checked as its flag is. A switch of integrator drops the flags that do not apply to the new
+// one and takes those that do as launched (`launched`: the command's own). Throws UsageError
+// naming the field for an unknown field, a wrong type or a value out of range.
+void read_change(const nlohmann::json& change, StateFields& fields, const driver::RenderArgs& launched);
+
+// The table's viewer fields of `args`, as read_change() takes them (an unset one is null).
+nlohmann::json state_fields(const driver::RenderArgs& args);
+
+nlohmann::json vec_json(Vec3 v);
 
 }  // namespace tracer::view
