@@ -23,11 +23,15 @@
 namespace tracer {
 namespace {
 
-std::vector<std::string> targets() { return {"auto", "avx2", "sse4"}; }
-
-struct TargetGuard {
-  ~TargetGuard() { WideBvh::force_simd_target("auto"); }
-};
+// Every SIMD target this CPU has, each tree built for one (a narrower one where the CPU lacks it).
+std::vector<SimdTarget> targets() { return {SimdTarget::Auto, SimdTarget::Avx2, SimdTarget::Sse4}; }
+std::string target_name(SimdTarget t) {
+  return std::string(name_of<SimdTarget>(kSimdTargetNames, t)) + " -> " + SimdDispatch::of(t).name();
+}
+BvhBuildOptions for_target(SimdTarget t, BvhBuildOptions o = {}) {
+  o.simd = t;
+  return o;
+}
 
 size_t disagreements(const Scene& scene, const std::vector<Ray>& rays, const BvhBuildOptions& wide_options = {}) {
   const Bvh bin(scene, BvhBuildOptions{});
@@ -63,32 +67,48 @@ std::vector<Scene> agreement_scenes() {
   return scenes;
 }
 
-// Runs `check` on every agreement scene with every SIMD target this CPU has, forced one by one.
-void for_each_target_and_scene(const std::function<void(const Scene&)>& check) {
-  TargetGuard guard;
+// Runs `check` on every agreement scene with every SIMD target this CPU has, one by one.
+void for_each_target_and_scene(const std::function<void(const Scene&, SimdTarget)>& check) {
   const std::vector<Scene> scenes = agreement_scenes();
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    SCOPED_TRACE(target + " -> " + WideBvh::simd_target());
+  for (const SimdTarget target : targets()) {
+    SCOPED_TRACE(target_name(target));
     for (const Scene& scene : scenes) {
       SCOPED_TRACE(scene.source);
-      check(scene);
+      check(scene, target);
     }
   }
 }
 
 TEST(WideBvh, AgreesWithBinaryBvhOnEveryTarget) {
-  for_each_target_and_scene([](const Scene& scene) {
-    EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 77)), 0u);
+  for_each_target_and_scene([](const Scene& scene, SimdTarget target) {
+    EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 77), for_target(target)),
+              0u);
   });
+}
+
+// Trees of different targets side by side in one process: each runs its own kernels.
+TEST(WideBvh, TheSimdTargetIsEachTreesOwn) {
+  const Scene scene = make_cornell_box(500);
+  const WideBvh sse4(scene, for_target(SimdTarget::Sse4)), best(scene, for_target(SimdTarget::Auto));
+  EXPECT_EQ(sse4.simd().name(), "SSE4");
+  EXPECT_EQ(best.simd().name(), SimdDispatch::of(SimdTarget::Auto).name());
+  EXPECT_EQ(SimdDispatch::of(SimdTarget::Auto).name(), SimdDispatch::of(SimdTarget::Avx512).name());
+  for (const Ray& r : test::random_rays(scene, 2000, 5)) {
+    Hit a, b;
+    EXPECT_EQ(sse4.intersect(r, a), best.intersect(r, b));
+    EXPECT_EQ(a.tri, b.tri);
+    EXPECT_EQ(a.t, b.t);
+  }
 }
 
 // Spatial splits cut references, never triangles: the same hits as the binary tree.
 TEST(WideBvh, SpatialSplitsAgreeWithBinaryBvhOnEveryTarget) {
   BvhBuildOptions high;
   high.split_budget = kHighSplitBudget;
-  for_each_target_and_scene([&](const Scene& scene) {
-    EXPECT_EQ(disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 78), high), 0u);
+  for_each_target_and_scene([&](const Scene& scene, SimdTarget target) {
+    EXPECT_EQ(
+        disagreements(scene, test::random_rays(scene, test::ray_budget(100'000) / 5, 78), for_target(target, high)),
+        0u);
   });
 }
 
@@ -430,15 +450,13 @@ TEST(SpatialSplit, ClippedBoxesHoldTheirPartOfTheTriangle) {
 }
 
 TEST(WideBvh, WatertightClosedSphere) {
-  TargetGuard guard;
   const IndexedMesh m = make_uv_sphere({0.1f, 0.2f, -0.3f}, 2.0f, 48, 24);
   Scene scene;
   scene.materials.push_back(Material{});
   scene.add_mesh("sphere", m.vertices, m.indices, 0);
   scene.finalize();
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    const WideBvh wide(scene, BvhBuildOptions{});
+  for (const SimdTarget target : targets()) {
+    const WideBvh wide(scene, for_target(target));
     size_t leaks = 0;
     for (size_t i = 0; i < m.vertices.size(); ++i) {
       for (const Vec3 origin : {Vec3{0.1f, 0.2f, -0.3f}, Vec3{0.5f, 0.1f, 0.0f}}) {
@@ -450,12 +468,11 @@ TEST(WideBvh, WatertightClosedSphere) {
         leaks += wide.occluded(r) ? 0 : 1;
       }
     }
-    EXPECT_EQ(leaks, 0u) << target;
+    EXPECT_EQ(leaks, 0u) << target_name(target);
   }
 }
 
 TEST(SimdBruteForce, AgreesWithScalarBruteForceOnEveryTarget) {
-  TargetGuard guard;
   std::vector<Scene> scenes;
   scenes.push_back(make_cornell_box(300));
   const Triangle t{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
@@ -463,12 +480,11 @@ TEST(SimdBruteForce, AgreesWithScalarBruteForceOnEveryTarget) {
   scenes.push_back(test::scene_of(std::vector<Triangle>(17, t)));  // ties across packs
   if (test::have_shared_scenes())
     scenes.push_back(load_obj(test::scene_path("cornell-box/CornellBox-Sphere.obj"), [](const std::string&) {}));
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
+  for (const SimdTarget target : targets()) {
     for (const Scene& scene : scenes) {
-      SCOPED_TRACE(target + " " + scene.source + " " + std::to_string(scene.size()));
+      SCOPED_TRACE(target_name(target) + " " + scene.source + " " + std::to_string(scene.size()));
       const BruteForce scalar(scene);
-      const SimdBruteForce simd(scene);
+      const SimdBruteForce simd(scene, target);
       std::vector<Ray> rays = test::random_rays(scene, 3000, 11);
       for (size_t i = 0; i < scene.size(); i += 3) {  // straight at triangles, and from their surfaces
         Ray r;
@@ -540,8 +556,8 @@ std::vector<Ray> primary_rays_in_packet_order(const Scene& scene, int width, int
 }
 
 TEST(RayPackets, SameHitsAsSingleRaysOnEveryTarget) {
-  for_each_target_and_scene([](const Scene& scene) {
-    const WideBvh wide(scene, BvhBuildOptions{});
+  for_each_target_and_scene([](const Scene& scene, SimdTarget target) {
+    const WideBvh wide(scene, for_target(target));
     // Coherent: every primary ray of a 61x47 render (partial packets at the right and bottom).
     EXPECT_EQ(packet_disagreements(wide, primary_rays_in_packet_order(scene, 61, 47)), 0u);
     // Incoherent: random rays, mostly packets whose rays do not share shear axes.
@@ -555,7 +571,6 @@ TEST(RayPackets, SameHitsAsSingleRaysOnEveryTarget) {
 TEST(RayPackets, RaysThroughVerticesAndEdges) {
   // Vertical rays straight down through every vertex of the box's axis-aligned walls and the
   // spheres: edge functions come out exactly zero, the lanes the scalar test decides in double.
-  TargetGuard guard;
   const Scene scene = make_cornell_box(800);
   std::vector<Ray> rays;
   for (const Triangle& t : scene.triangles) {
@@ -571,10 +586,9 @@ TEST(RayPackets, RaysThroughVerticesAndEdges) {
   }
   std::stable_partition(rays.begin(), rays.end(),
                         [](const Ray& r) { return r.dir.y != 0.0f; });  // shared axes per packet
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    const WideBvh wide(scene, BvhBuildOptions{});
-    EXPECT_EQ(packet_disagreements(wide, rays), 0u) << target;
+  for (const SimdTarget target : targets()) {
+    const WideBvh wide(scene, for_target(target));
+    EXPECT_EQ(packet_disagreements(wide, rays), 0u) << target_name(target);
   }
 }
 
@@ -641,11 +655,11 @@ size_t bundle_disagreements(const A& accel, const std::vector<BundleCase>& cases
 }
 
 TEST(RayBundles, SameAnswersAsSingleRaysOnEveryTarget) {
-  for_each_target_and_scene([](const Scene& scene) {
+  for_each_target_and_scene([](const Scene& scene, SimdTarget target) {
     const std::vector<BundleCase> cases = bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 17);
-    const Bvh binary(scene, BvhBuildOptions{});
+    const Bvh binary(scene, for_target(target));
     EXPECT_EQ(bundle_disagreements(binary, cases), 0u) << "bvh";
-    const WideBvh wide(scene, BvhBuildOptions{});
+    const WideBvh wide(scene, for_target(target));
     EXPECT_EQ(bundle_disagreements(wide, cases), 0u) << "bvh8";
   });
 }
@@ -654,7 +668,6 @@ TEST(RayBundles, RaysThroughVerticesAndEdges) {
   // One bundle above each vertex and edge midpoint of the box's axis-aligned walls and spheres:
   // lane 0 straight down through the point (edge functions exactly zero, decided in double),
   // the others spread below it.
-  TargetGuard guard;
   const Scene scene = make_cornell_box(800);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
@@ -670,10 +683,9 @@ TEST(RayBundles, RaysThroughVerticesAndEdges) {
       cases.push_back(c);
     }
   }
-  for (const std::string& target : targets()) {
-    ASSERT_TRUE(WideBvh::force_simd_target(target));
-    EXPECT_EQ(bundle_disagreements(Bvh(scene, BvhBuildOptions{}), cases), 0u) << target << " bvh";
-    EXPECT_EQ(bundle_disagreements(WideBvh(scene, BvhBuildOptions{}), cases), 0u) << target << " bvh8";
+  for (const SimdTarget target : targets()) {
+    EXPECT_EQ(bundle_disagreements(Bvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh";
+    EXPECT_EQ(bundle_disagreements(WideBvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh8";
   }
 }
 

@@ -38,8 +38,8 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       acc.name = "brute";
       break;
     case AccelKind::BruteSimd:
-      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<SimdBruteForce>, scene);
-      acc.name = "simd-brute-" + WideBvh::simd_target();
+      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<SimdBruteForce>, scene, options.bvh.simd);
+      acc.name = "simd-brute-" + std::get<SimdBruteForce>(*acc.impl).simd().name();
       break;
     case AccelKind::Bvh:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<Bvh>, scene, options.bvh);
@@ -50,7 +50,7 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       const bool high = options.quality == BuildQuality::High;
       bvh.split_budget = high ? kHighSplitBudget : 0.0f;
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, bvh);
-      acc.name = "bvh8-" + WideBvh::simd_target() + (high ? "-high" : "");
+      acc.name = "bvh8-" + std::get<WideBvh>(*acc.impl).simd().name() + (high ? "-high" : "");
       break;
     }
     case AccelKind::Embree:

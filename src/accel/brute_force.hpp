@@ -6,6 +6,7 @@
 
 #include "accel/kernels/triangle_pack.hpp"
 #include "accel/kernels/triangle_test.hpp"
+#include "base/simd_dispatch.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -49,16 +50,18 @@ class BruteForce {
 // at a time, through the same pack kernel as the wide BVH's leaves.
 class SimdBruteForce {
  public:
-  explicit SimdBruteForce(const Scene& scene);
+  explicit SimdBruteForce(const Scene& scene, SimdTarget simd = SimdTarget::Auto);
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
   const std::vector<TrianglePack>& packs() const { return packs_; }
   const Scene& scene() const { return *scene_; }
   size_t memory_bytes() const { return packs_.size() * sizeof(TrianglePack); }
+  const SimdDispatch& simd() const { return simd_; }
 
  private:
   const Scene* scene_;
   std::vector<TrianglePack> packs_;
+  SimdDispatch simd_;
 };
 
 }  // namespace tracer

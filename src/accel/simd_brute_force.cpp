@@ -49,11 +49,11 @@ HWY_EXPORT(IntersectBrute);
 HWY_EXPORT(OccludedBrute);
 
 bool SimdBruteForce::intersect(const Ray& ray, Hit& hit) const {
-  return HWY_DYNAMIC_DISPATCH(IntersectBrute)(*this, ray, hit);
+  return SIMD_DISPATCH(simd_, IntersectBrute)(*this, ray, hit);
 }
-bool SimdBruteForce::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedBrute)(*this, ray); }
+bool SimdBruteForce::occluded(const Ray& ray) const { return SIMD_DISPATCH(simd_, OccludedBrute)(*this, ray); }
 
-SimdBruteForce::SimdBruteForce(const Scene& scene) : scene_(&scene) {
+SimdBruteForce::SimdBruteForce(const Scene& scene, SimdTarget simd) : scene_(&scene), simd_(SimdDispatch::of(simd)) {
   std::vector<uint32_t> ids;
   for (uint32_t i = 0; i < scene.size(); ++i) {
     if (!scene.triangles[i].degenerate()) ids.push_back(i);

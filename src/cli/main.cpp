@@ -58,8 +58,8 @@ int cmd_render(const RenderArgs& args) {
   const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
     return render_round(accel, ctx, passes, setup.sched, control);
   };
-  const FrameSequence frames{args.output, args.frames,       args.orbit,     args.checkpoint,
-                             args.exr,    args.save_partial, aovs_for(args), args.denoise};
+  const FrameSequence frames{args.output,       args.frames,    args.orbit,   args.checkpoint, args.exr,
+                             args.save_partial, aovs_for(args), args.denoise, args.simd_target};
   const Executor denoiser(setup.sched.strategy, setup.sched.threads);
   const DriveResult r =
       drive_render(scene, setup.camera, settings, frames,

@@ -309,9 +309,9 @@ HWY_EXPORT(PatchDistances);
 HWY_EXPORT(FilterStepT);
 HWY_EXPORT(RegressionRowT);
 
-void patch_distances(const PatchDistance& a) { HWY_DYNAMIC_DISPATCH(PatchDistances)(a); }
-void filter_step(const FilterStep& a) { HWY_DYNAMIC_DISPATCH(FilterStepT)(a); }
-void regression_row(const RegressionRow& a) { HWY_DYNAMIC_DISPATCH(RegressionRowT)(a); }
+void patch_distances(const PatchDistance& a, SimdDispatch simd) { SIMD_DISPATCH(simd, PatchDistances)(a); }
+void filter_step(const FilterStep& a, SimdDispatch simd) { SIMD_DISPATCH(simd, FilterStepT)(a); }
+void regression_row(const RegressionRow& a, SimdDispatch simd) { SIMD_DISPATCH(simd, RegressionRowT)(a); }
 size_t regression_scratch_floats(int radius) {
   const size_t widest = 16, offsets = size_t(2 * radius + 1) * size_t(2 * radius + 1);
   return widest * (2 * offsets + size_t(2 * kRegressionEntries) + size_t(kDim * kDim));

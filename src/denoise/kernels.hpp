@@ -5,6 +5,7 @@
 // flat, and a pixel's result depends on its neighbourhood only, not on the tiling or the thread.
 #pragma once
 
+#include "base/simd_dispatch.hpp"
 #include "denoise/planes.hpp"
 
 namespace tracer::denoise {
@@ -29,7 +30,7 @@ struct PatchDistance {
   int x0, y0, ox, oy, patch;
   float* out;
 };
-void patch_distances(const PatchDistance& a);
+void patch_distances(const PatchDistance& a, SimdDispatch simd);
 
 // For every pixel p of the tile: adds w * image(q) to acc[c] (c < channels) and w to
 // acc[channels], each a plane of kTilePixels, with w = exp(-max(0, distance) * inv_k2) * valid(q).
@@ -41,7 +42,7 @@ struct FilterStep {
   float inv_k2;
   float* acc;
 };
-void filter_step(const FilterStep& a);
+void filter_step(const FilterStep& a, SimdDispatch simd);
 
 // The weighted first-order regression of every pixel p of row `ty` of the tile at (x0, y0), at
 // each bandwidth b < bandwidths: over the window's offsets q - p, the least squares of
@@ -64,7 +65,7 @@ struct RegressionRow {
   float* scratch;  // regression_scratch_floats(radius) floats, aligned for any SIMD target
   Planes* out[2];
 };
-void regression_row(const RegressionRow& a);
+void regression_row(const RegressionRow& a, SimdDispatch simd);
 size_t regression_scratch_floats(int radius);
 
 }  // namespace tracer::denoise

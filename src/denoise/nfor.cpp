@@ -46,6 +46,7 @@ struct Context {
   const Planes& valid;
   const Executor& executor;
   CancelFlag cancel;
+  SimdDispatch simd;
 };
 
 // f(x, y) for every pixel of a width x height image, bands of kTileHeight rows on the executor;
@@ -75,8 +76,8 @@ Planes nl_means(const Context& cx, const Planes& image, const Planes& guide, con
     Floats acc = zeros(size_t(channels + 1) * kTilePixels), distance = zeros(kTilePixels);
     for (int oy = -radius; oy <= radius; ++oy) {
       for (int ox = -radius; ox <= radius; ++ox) {
-        patch_distances({&guide, &variance, x0, y0, ox, oy, patch, distance.get()});
-        filter_step({&image, &cx.valid, x0, y0, ox, oy, distance.get(), 1.0f / (k * k), acc.get()});
+        patch_distances({&guide, &variance, x0, y0, ox, oy, patch, distance.get()}, cx.simd);
+        filter_step({&image, &cx.valid, x0, y0, ox, oy, distance.get(), 1.0f / (k * k), acc.get()}, cx.simd);
       }
     }
     for_tile_pixels(x0, y0, w, h, [&](int x, int y, int i) {
@@ -102,7 +103,8 @@ std::vector<Planes> regress(const Context& cx, const Planes& image, const Planes
     Floats distances = zeros(size_t(offsets) * kTilePixels);
     for (int o = 0; o < offsets; ++o) {
       patch_distances({&guide, &variance, x0, y0, o % edge - radius, o / edge - radius, patch,
-                       distances.get() + size_t(o) * kTilePixels});
+                       distances.get() + size_t(o) * kTilePixels},
+                      cx.simd);
     }
     Floats scratch = zeros(regression_scratch_floats(radius));
     RegressionRow row{&image,
@@ -122,7 +124,7 @@ std::vector<Planes> regress(const Context& cx, const Planes& image, const Planes
       row.inv_k2[b] = 1.0f / (ks[size_t(b)] * ks[size_t(b)]);
       row.out[b] = &out[size_t(b)];
     }
-    for (row.ty = 0; row.ty < kTileHeight && y0 + row.ty < h; ++row.ty) regression_row(row);
+    for (row.ty = 0; row.ty < kTileHeight && y0 + row.ty < h; ++row.ty) regression_row(row, cx.simd);
   });
   return out;
 }
@@ -248,7 +250,7 @@ Guide demodulated(const Context& cx, const Planes& colour, const Planes& varianc
 std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, CancelFlag cancel, const NforOptions& o) {
   const int w = film.width(), h = film.height();
   Planes valid(w, h, 1);
-  const Context cx{valid, executor, cancel};
+  const Context cx{valid, executor, cancel, SimdDispatch::of(o.simd)};
   for_pixels(cx, w, h, [&](int x, int y) { valid(0, x, y) = 1.0f; });
   Halves hv = halves_of(cx, film);
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "base/errors.hpp"
+#include "base/simd_dispatch.hpp"
 #include "film/feature_film.hpp"
 #include "math/vec.hpp"
 #include "parallel/executor.hpp"
@@ -31,6 +32,7 @@ struct NforOptions {
   int patch = 1, radius = 5;                  // 5.2 and 5.4
   int error_patch = 1, error_radius = 3;      // 5.3: smoothing the error and choice maps
   bool second_pass = true;                    // 5.4
+  SimdTarget simd = SimdTarget::Auto;         // the widest target its kernels may use (--simd-target)
 };
 
 // The denoised radiance of every pixel of `film`, row-major. Throws Cancelled once `cancel` is

@@ -12,7 +12,6 @@ PreparedRender::PreparedRender(const RenderArgs& args, const PrepareOptions& opt
   validate(args);
   if (options.writes_outputs) check_outputs(args);
   thread_limit = ThreadLimit(args.threads.value_or(0));
-  WideBvh::force_simd_target(args.simd_target);
   // Memory is checked before it is taken: the film from the flags alone, the scene (a glTF's
   // instances before they are expanded) with what its accelerator will need, then the whole.
   const uint64_t memory = memory_limit(args.scene);

@@ -66,7 +66,8 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
       const Framebuffer* image = &*fb;
       if (features && final_image) {
         const auto start = Clock::now();
-        const std::vector<Vec3> d = denoise::nfor(*features, *options.denoiser, options.cancel);
+        const std::vector<Vec3> d =
+            denoise::nfor(*features, *options.denoiser, options.cancel, {.simd = seq.denoise_simd});
         result.denoise_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         for (int y = 0; y < fb->height(); ++y) {
           for (int x = 0; x < fb->width(); ++x) denoised->set(x, y, d[size_t(y) * size_t(fb->width()) + size_t(x)]);

@@ -31,9 +31,10 @@ struct FrameSequence {
   double orbit_degrees = 0.0;
   std::optional<double> checkpoint_seconds;  // rewrite the output this often while passes add up
   ExrPixel exr = ExrPixel::Half;
-  bool save_partial = false;  // on a stop, write finished tiles of a frame with no complete pass
-  Aovs aovs;                  // --aov: layers written into the EXR beside the radiance
-  bool denoise = false;       // --denoise: every image written is denoise::nfor's of the film
+  bool save_partial = false;                   // on a stop, write finished tiles of a frame with no complete pass
+  Aovs aovs;                                   // --aov: layers written into the EXR beside the radiance
+  bool denoise = false;                        // --denoise: every image written is denoise::nfor's of the film
+  SimdTarget denoise_simd = SimdTarget::Auto;  // the widest target the denoiser's kernels may use
 };
 
 // Renders the passes of `round` of the frame `ctx` describes into ctx.framebuffer (null on a rank

@@ -86,6 +86,7 @@ AccelOptions accel_options_for(const RenderArgs& a) {
     throw UsageError("--simd off: simd-brute is the SIMD brute force; use --accel brute for the scalar one");
   }
   o.bvh.threads = a.threads.value_or(0);
+  o.bvh.simd = a.simd_target;
   if (a.build_quality) {
     o.quality = *a.build_quality;
     if (!has_build_quality(o.kind)) throw UsageError("--build-quality: only bvh8 and embree build at a quality level");

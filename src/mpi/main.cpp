@@ -57,8 +57,8 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   const driver::PreparedRender& prepared = *setup.prepared;
   RankRender rank(prepared, args, session, std::move(agreement.threads), rank_timeout, watch_phase);
   // Signals end a rank at once (install_immediate_stop_handlers): no round is ever stopped.
-  const driver::FrameSequence frames{args.output, args.frames, args.orbit, args.checkpoint,
-                                     args.exr,    false,       {},         args.denoise};
+  const driver::FrameSequence frames{args.output, args.frames, args.orbit,   args.checkpoint, args.exr,
+                                     false,       {},          args.denoise, args.simd_target};
   // Rank 0 denoises the gathered film with its own threads.
   const Executor denoiser(prepared.sched.strategy, prepared.sched.threads);
   const driver::DriveResult driven = driver::drive_render(

@@ -369,7 +369,8 @@ bool ViewSession::denoise_display(const Job& job, bool last_pass) {
   const auto t0 = Clock::now();
   std::vector<Vec3> image;
   try {
-    image = denoise::nfor(*features_, denoiser_, &interrupt_);  // a change stops it within a tile
+    image = denoise::nfor(*features_, denoiser_, &interrupt_,
+                          {.simd = launched_.simd_target});  // a change stops it within a tile
   } catch (const Cancelled&) {
     return false;
   }

@@ -178,7 +178,7 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options)
     : Bvh(scene, options, Executor(options.strategy, options.threads)) {}
 
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
-    : scene_(&scene), options_(options_in) {
+    : scene_(&scene), options_(options_in), simd_(SimdDispatch::of(options_in.simd)) {
   options_.split_budget = 0.0f;  // one leaf per triangle (leaf_of)
   const BvhBuildOptions& options = options_;
   exec.run([&] {

@@ -200,7 +200,7 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
     : WideBvh(scene, options, Executor(options.strategy, options.threads)) {}
 
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
-    : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f) {
+    : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f), simd_(SimdDispatch::of(options_in.simd)) {
   BvhBuildOptions options = options_in;
   // Nodes of more than one pack are always split, so the SAH never weighs a leaf larger than one.
   options.max_leaf = std::min(options.max_leaf, kWideWidth);

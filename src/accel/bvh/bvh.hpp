@@ -16,6 +16,7 @@
 #include "base/enum_names.hpp"
 #include "base/errors.hpp"
 #include "base/huge_pages.hpp"
+#include "base/simd_dispatch.hpp"
 #include "math/aabb.hpp"
 #include "math/ray_packet.hpp"
 #include "parallel/executor.hpp"
@@ -28,10 +29,11 @@ inline constexpr EnumName<BvhSplit> kBvhSplitNames[] = {{BvhSplit::Sah, "sah"}, 
 
 struct BvhBuildOptions {
   BvhSplit split = BvhSplit::Sah;
-  Strategy strategy = Strategy::Tbb;  // how the build forks (Executor); Atomic forks nothing
-  int threads = 0;                    // 0: all hardware threads (parallel modes only)
-  int max_leaf = 4;                   // SAH: largest leaf; the median split always makes leaves of 1-2
-  int bins = 16;                      // SAH bins per axis
+  Strategy strategy = Strategy::Tbb;   // how the build forks (Executor); Atomic forks nothing
+  int threads = 0;                     // 0: all hardware threads (parallel modes only)
+  SimdTarget simd = SimdTarget::Auto;  // the widest target the built tree's SIMD kernels may use
+  int max_leaf = 4;                    // SAH: largest leaf; the median split always makes leaves of 1-2
+  int bins = 16;                       // SAH bins per axis
   // Spatial splits may add up to this fraction of references (0: none). The 8-wide BVH only: the
   // binary tree keeps one leaf per triangle.
   float split_budget = 0.0f;
@@ -132,6 +134,7 @@ class Bvh {
   std::vector<uint32_t> ids_;
   std::vector<uint32_t> pair_parent_;  // parent of the sibling pair nodes_[2k], nodes_[2k+1], at k
   std::vector<uint32_t> leaf_of_;      // leaf holding each scene triangle (kInvalidIndex: degenerate)
+  SimdDispatch simd_;                  // the AO bundles' kernel target
 };
 
 // Slab test of one ray against one binary node's box, with a per-ray reciprocal direction

@@ -144,7 +144,7 @@ namespace tracer {
 HWY_EXPORT(OccludedBundleFrom);
 
 uint32_t Bvh::occluded_bundle_from(const RayBundle& rays, uint32_t origin) const {
-  return HWY_DYNAMIC_DISPATCH(OccludedBundleFrom)(*this, rays, origin);
+  return SIMD_DISPATCH(simd_, OccludedBundleFrom)(*this, rays, origin);
 }
 
 }  // namespace tracer

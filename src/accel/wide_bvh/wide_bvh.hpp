@@ -17,11 +17,6 @@
 
 namespace tracer {
 
-// The widest SIMD target the kernels may use; Auto is the CPU's best.
-enum class SimdTarget { Auto, Avx512, Avx2, Sse4 };
-inline constexpr EnumName<SimdTarget> kSimdTargetNames[] = {
-    {SimdTarget::Auto, "auto"}, {SimdTarget::Avx512, "avx512"}, {SimdTarget::Avx2, "avx2"}, {SimdTarget::Sse4, "sse4"}};
-
 struct alignas(64) WideNode {
   // Children's boxes, one lane per child; an empty slot has lo = +inf, hi = -inf and never hits.
   float lo_x[kWideWidth], lo_y[kWideWidth], lo_z[kWideWidth];
@@ -72,13 +67,8 @@ class WideBvh {
   bool spatial_splits() const { return spatial_splits_; }
   const Scene& scene() const { return *scene_; }
 
-  // The SIMD target the kernels run on (e.g. "AVX3", "AVX2", "SSE4").
-  static std::string simd_target();
-  // Restricts the kernels to targets no wider than `name` ("sse4", "avx2", "avx512"); for
-  // testing every target and for `--simd-target`. Returns false for an unknown name.
-  static bool force_simd_target(const std::string& name);
-  // Process-wide: every later dispatch of the SIMD kernels uses at most `target`.
-  static void force_simd_target(SimdTarget target);
+  // The SIMD target its kernels run on: options.simd, or the CPU's best narrower than that.
+  const SimdDispatch& simd() const { return simd_; }
 
  private:
   const Scene* scene_;
@@ -86,6 +76,7 @@ class WideBvh {
   PackArray packs_;
   Aabb bounds_;
   bool spatial_splits_ = false;
+  SimdDispatch simd_;
 };
 
 }  // namespace tracer

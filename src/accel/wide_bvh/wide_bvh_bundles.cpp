@@ -126,10 +126,10 @@ HWY_EXPORT(OccludedBundleWide);
 HWY_EXPORT(OccludedBundleWideCounted);
 
 uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t origin) const {
-  return HWY_DYNAMIC_DISPATCH(OccludedBundleWide)(*this, rays, origin);
+  return SIMD_DISPATCH(simd_, OccludedBundleWide)(*this, rays, origin);
 }
 uint32_t WideBvh::occluded_bundle_from(const RayBundle& rays, uint32_t /*origin*/, TraversalCounts& counts) const {
-  return HWY_DYNAMIC_DISPATCH(OccludedBundleWideCounted)(*this, rays, &counts);
+  return SIMD_DISPATCH(simd_, OccludedBundleWideCounted)(*this, rays, &counts);
 }
 
 }  // namespace tracer

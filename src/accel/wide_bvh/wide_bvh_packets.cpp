@@ -265,10 +265,10 @@ HWY_EXPORT(IntersectPacketWide);
 HWY_EXPORT(IntersectPacketWideCounted);
 
 void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits) const {
-  HWY_DYNAMIC_DISPATCH(IntersectPacketWide)(*this, rays, hits);
+  SIMD_DISPATCH(simd_, IntersectPacketWide)(*this, rays, hits);
 }
 void WideBvh::intersect_packet(const RayPacket& rays, Hit* hits, TraversalCounts& counts) const {
-  HWY_DYNAMIC_DISPATCH(IntersectPacketWideCounted)(*this, rays, hits, &counts);
+  SIMD_DISPATCH(simd_, IntersectPacketWideCounted)(*this, rays, hits, &counts);
 }
 
 }  // namespace tracer

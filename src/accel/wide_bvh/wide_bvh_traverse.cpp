@@ -68,13 +68,13 @@ HWY_EXPORT(OccludedWideCounted);
 
 // One table-indexed call per ray (Highway's dynamic dispatch), never per node: the kernels above
 // inline the whole traversal.
-bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return HWY_DYNAMIC_DISPATCH(IntersectWide)(*this, ray, hit); }
-bool WideBvh::occluded(const Ray& ray) const { return HWY_DYNAMIC_DISPATCH(OccludedWide)(*this, ray); }
+bool WideBvh::intersect(const Ray& ray, Hit& hit) const { return SIMD_DISPATCH(simd_, IntersectWide)(*this, ray, hit); }
+bool WideBvh::occluded(const Ray& ray) const { return SIMD_DISPATCH(simd_, OccludedWide)(*this, ray); }
 bool WideBvh::intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const {
-  return HWY_DYNAMIC_DISPATCH(IntersectWideCounted)(*this, ray, hit, &counts);
+  return SIMD_DISPATCH(simd_, IntersectWideCounted)(*this, ray, hit, &counts);
 }
 bool WideBvh::occluded(const Ray& ray, TraversalCounts& counts) const {
-  return HWY_DYNAMIC_DISPATCH(OccludedWideCounted)(*this, ray, &counts);
+  return SIMD_DISPATCH(simd_, OccludedWideCounted)(*this, ray, &counts);
 }
 
 }  // namespace tracer
