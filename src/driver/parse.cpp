@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "base/errors.hpp"
+#include "base/whole_number.hpp"
 
 namespace tracer::driver {
 
@@ -15,14 +16,12 @@ Vec3 parse_vec3(const std::string& flag, const std::string& text) {
   for (;;) {
     const size_t comma = text.find(',', pos);
     const std::string part = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    const char* b = part.data();
-    const char* e = b + part.size();
     double value = 0;
-    const auto [ptr, ec] = std::from_chars(b, e, value);
-    if (n == 3 || part.empty() || ptr != e || (ec != std::errc{} && ec != std::errc::result_out_of_range)) {
+    const WholeNumber read = read_whole_number(part, value);
+    if (n == 3 || read == WholeNumber::NotANumber) {
       throw UsageError(flag + ": expected three numbers x,y,z, got '" + text + "'");
     }
-    if (ec == std::errc::result_out_of_range || !std::isfinite(value) || std::fabs(value) > 3.4e38) {
+    if (read == WholeNumber::OutOfRange || !std::isfinite(value) || std::fabs(value) > 3.4e38) {
       throw UsageError(flag + ": '" + part + "' is out of range (not a finite float) in '" + text + "'");
     }
     v[n++] = value;
@@ -48,11 +47,8 @@ std::pair<int, int> parse_size(const std::string& flag, const std::string& text)
   int v[2] = {0, 0};
   const std::string parts[2] = {text.substr(0, x), x == std::string::npos ? "" : text.substr(x + 1)};
   for (int i = 0; i < 2; ++i) {
-    const char* b = parts[i].data();
-    const char* e = b + parts[i].size();
     long long n = 0;
-    const auto [ptr, ec] = std::from_chars(b, e, n);
-    if (parts[i].empty() || ec != std::errc{} || ptr != e)
+    if (read_whole_number(parts[i], n) != WholeNumber::Ok)
       throw UsageError(flag + ": expected WxH (two whole numbers), got '" + text + "'");
     check_range(flag + (i == 0 ? " width" : " height"), n, 1, 16384);
     v[i] = int(n);

@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "base/errors.hpp"
+#include "base/whole_number.hpp"
 #include "driver/parse.hpp"
 #include "driver/render_options.hpp"
 #include "io/image_io.hpp"
@@ -86,18 +87,17 @@ double json_number(const std::string& name, const json& value) {
   return value.get<double>();
 }
 
-// One grammar for the command line's numbers: std::from_chars on the whole word (no sign '+', no
-// spaces, no hex), as the viewer's JSON numbers are read by nlohmann-json's own.
+// The command line's numbers are whole words (base/whole_number.hpp); the viewer's JSON numbers
+// are nlohmann-json's.
 template <class I>
 Codec<I> whole(long long lo, long long hi) {
   Codec<I> c;
   c.parse = [lo, hi](const std::string& name, const std::string& text) {
     long long v = 0;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ptr != text.data() + text.size() || text.empty() || (ec != std::errc{} && ec != std::errc::result_out_of_range))
-      throw UsageError(name + ": expected a whole number, got '" + text + "'");
+    const WholeNumber read = read_whole_number(text, v);
+    if (read == WholeNumber::NotANumber) throw UsageError(name + ": expected a whole number, got '" + text + "'");
     // Checked on the text as given: a number beyond long long is quoted as typed.
-    if (ec != std::errc{} || v < lo || v > hi)
+    if (read == WholeNumber::OutOfRange || v < lo || v > hi)
       throw UsageError(name + ": must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " +
                        text);
     return I(v);
@@ -120,10 +120,10 @@ Codec<F> real(double lo, double hi, LowEnd low = LowEnd::Closed) {
   Codec<F> c;
   c.parse = [](const std::string& name, const std::string& text) {
     double v = 0;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ptr != text.data() + text.size() || text.empty() || (ec != std::errc{} && ec != std::errc::result_out_of_range))
-      throw UsageError(name + ": expected a number, got '" + text + "'");
-    if (ec != std::errc{}) throw UsageError(name + ": '" + text + "' is out of range (not a finite number)");
+    const WholeNumber read = read_whole_number(text, v);
+    if (read == WholeNumber::NotANumber) throw UsageError(name + ": expected a number, got '" + text + "'");
+    if (read == WholeNumber::OutOfRange)
+      throw UsageError(name + ": '" + text + "' is out of range (not a finite number)");
     return F(v);
   };
   c.format = [](const F& v) { return shortest(v); };

@@ -1,4 +1,5 @@
 #include "scene/views.hpp"
+#include "base/whole_number.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -24,8 +25,7 @@ std::vector<std::string> split_tabs(std::string_view line) {
 }
 
 bool parse_number(std::string_view text, float& out) {
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return ec == std::errc{} && ptr == text.data() + text.size() && std::isfinite(out);
+  return read_whole_number(text, out) == WholeNumber::Ok && std::isfinite(out);
 }
 
 Vec3 parse_field_vec3(const std::string& text, const std::string& where, const char* field) {
