@@ -24,9 +24,9 @@ const FeatureFilm& film() {
     s.spp = 4;
     Framebuffer image(kSize, kSize);
     FeatureFilm features(kSize, kSize);
-    RenderContext ctx{&scene, Camera(*scene.camera, kSize, kSize), s, &image};
+    PassContext ctx{&scene, Camera(*scene.camera, kSize, kSize), s, &image};
     ctx.features = &features;
-    RenderControl control;
+    RenderMonitor control;
     render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), SchedOptions{}, control);
     return features;
   }();

@@ -92,7 +92,7 @@ std::vector<SceneCase>& cases() {
       rs.ao_samples = 16;
       Framebuffer fb(rs.width, rs.height);
       const CameraSpec cam = c.scene->camera ? *c.scene->camera : frame_bounds(c.scene->bounds);
-      RenderContext ctx{c.scene.get(), Camera(cam, rs.width, rs.height), rs, &fb};
+      PassContext ctx{c.scene.get(), Camera(cam, rs.width, rs.height), rs, &fb};
       Recorder rec{c.bvh.get(), &c.rays};
       render_tile(rec, ctx, Tile{0, 0, rs.width, rs.height});
       v.push_back(std::move(c));

@@ -102,8 +102,8 @@ AdaptiveRender render_adaptive(const Scene& scene, const Accelerator& acc, const
   s.integrator = Integrator::Path;
   Framebuffer fb(s.width, s.height);
   fb.keep_halves();
-  RenderContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
+  RenderMonitor control;
   EXPECT_TRUE(render_round(acc, ctx, sample_passes(s), so, control));
   AdaptiveRender r;
   for (int y = 0; y < s.height; ++y) {
@@ -178,8 +178,8 @@ TEST(Adaptive, ConvergesToTheFixedSppImage) {
     s.noise_threshold = threshold;
     Framebuffer fb(s.width, s.height);
     if (threshold > 0.0f) fb.keep_halves();
-    RenderContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
-    RenderControl control;
+    PassContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
+    RenderMonitor control;
     EXPECT_TRUE(render_round(acc, ctx, sample_passes(s), SchedOptions{}, control));
     if (primary) *primary = control.counts.load().primary;
     return fb;

@@ -57,7 +57,7 @@ RaySet rays_for(const Scene& scene, size_t random_count, int image) {
                                                    scene.bounds.center(),
                                                    {0, 1, 0},
                                                    50.0f};
-  RenderContext ctx{&scene, Camera(cam, image, image), s, &fb};
+  PassContext ctx{&scene, Camera(cam, image, image), s, &fb};
   render_tile(rec, ctx, Tile{0, 0, image, image});
   set.closest.insert(set.closest.end(), rec.closest.begin(), rec.closest.end());
   set.any.insert(set.any.end(), rec.any.begin(), rec.any.end());
@@ -122,7 +122,7 @@ Image8 render_small(const A& accel, const Scene& scene, int size) {
   s.width = s.height = size;
   const CameraSpec cam{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
   Framebuffer fb(size, size);
-  RenderContext ctx{&scene, Camera(cam, size, size), s, &fb};
+  PassContext ctx{&scene, Camera(cam, size, size), s, &fb};
   render_tile(accel, ctx, Tile{0, 0, size, size});
   return tonemap(fb, s.exposure);
 }

@@ -39,9 +39,9 @@ Films render_box(int size, int spp, const SchedOptions& sched = {}) {
   s.width = s.height = size;
   s.spp = spp;
   Films f{Framebuffer(size, size), FeatureFilm(size, size)};
-  RenderContext ctx{&scene, Camera(*scene.camera, size, size), s, &f.image};
+  PassContext ctx{&scene, Camera(*scene.camera, size, size), s, &f.image};
   ctx.features = &f.features;
-  RenderControl control;
+  RenderMonitor control;
   EXPECT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), sched, control));
   return f;
 }

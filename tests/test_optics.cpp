@@ -79,8 +79,8 @@ Vec3 centre_radiance(const Scene& scene) {
   s.ambient = 0.0f;
   Framebuffer fb(s.width, s.height);
   const CameraSpec cam{{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 10.0f};
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   EXPECT_TRUE(render_image(build_accelerator(scene, AccelOptions{}), ctx, SchedOptions{}, control));
   return fb.radiance(4, 4);
 }

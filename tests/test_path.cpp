@@ -18,8 +18,8 @@ namespace {
 Framebuffer render_path(const Scene& scene, const CameraSpec& cam, RenderSettings s) {
   s.integrator = Integrator::Path;
   Framebuffer fb(s.width, s.height);
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   SchedOptions so;
   so.strategy = Strategy::Tbb;
   EXPECT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), so, control));
@@ -182,8 +182,8 @@ TEST(Path, WhittedSeesTheEnvironmentWhereNothingIsHit) {
   s.environment = Vec3{0.5f};
   Framebuffer fb(s.width, s.height);
   const Camera camera(CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 60.0f}, s.width, s.height);
-  RenderContext ctx{&scene, camera, s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, camera, s, &fb};
+  RenderMonitor control;
   ASSERT_TRUE(render_round(build_accelerator(scene, AccelOptions{}), ctx, sample_passes(s), SchedOptions{}, control));
   const Ray corner = camera.primary_ray(0, 0);
   const Vec3 expected = scene.environment_map.radiance(corner.dir) * 0.5f;
@@ -297,9 +297,9 @@ TEST(Path, EmittersBySolidAngleGiveAreaSamplingsImageWithLessNoise) {
       s.seed = seed;
       Framebuffer fb(s.width, s.height);
       FeatureFilm film(s.width, s.height);
-      RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+      PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
       ctx.features = &film;
-      RenderControl control;
+      RenderMonitor control;
       ASSERT_TRUE(render_round(accel, ctx, sample_passes(s), SchedOptions{}, control));
       for (int y = 0; y < s.height; ++y) {
         for (int x = 0; x < s.width; ++x) {

@@ -21,8 +21,8 @@ Framebuffer render(const Scene& scene, const CameraSpec& cam, const RenderSettin
                    const SchedOptions& so = {}) {
   const Accelerator acc = build_accelerator(scene, ao);
   Framebuffer fb(s.width, s.height);
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   EXPECT_TRUE(render_image(acc, ctx, so, control));
   return fb;
 }
@@ -112,8 +112,8 @@ TEST(Render, CountedTraversalChangesNoPixelAndCountsTheSameEverywhere) {
           RenderSettings r = s;
           r.count_traversal = counted;
           Framebuffer fb(r.width, r.height);
-          RenderContext ctx{&scene, Camera(*scene.camera, r.width, r.height), r, &fb};
-          RenderControl control;
+          PassContext ctx{&scene, Camera(*scene.camera, r.width, r.height), r, &fb};
+          RenderMonitor control;
           SchedOptions so;
           so.strategy = kind;
           so.threads = threads;

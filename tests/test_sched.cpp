@@ -30,8 +30,8 @@ Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOpti
   s.ao_samples = 4;
   Framebuffer fb(s.width, s.height);
   const CameraSpec cam = scene.camera ? *scene.camera : CameraSpec{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   Rendered out;
   std::mutex m;
   control.on_tile = [&](const Tile& t) {
@@ -134,8 +134,8 @@ std::vector<float> path_sums(const Scene& scene, const Accelerator& acc, const S
   s.spp = 6;  // passes of 1, 1, 2, 2
   Framebuffer fb(s.width, s.height);
   const CameraSpec cam = scene.camera ? *scene.camera : CameraSpec{{0, 1, 3}, {0, 1, 0}, {0, 1, 0}, 53.13f};
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   EXPECT_TRUE(render_round(acc, ctx, sample_passes(s), so, control));
   EXPECT_EQ(fb.min_samples(), uint32_t(s.spp));
   std::vector<float> sums;
@@ -183,9 +183,9 @@ TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
     s.width = s.height = 64;
     s.ao_samples = 1;
     Framebuffer fb(s.width, s.height);
-    RenderContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
+    PassContext ctx{&scene, Camera(*scene.camera, s.width, s.height), s, &fb};
     std::atomic<bool> cancel{false};
-    RenderControl control;
+    RenderMonitor control;
     control.cancel = &cancel;
     std::atomic<int> tiles{0};
     control.on_tile = [&](const Tile&) {

@@ -62,8 +62,8 @@ TEST(Texture, TexelsAppearWhereTheirCoordinatesSay) {
   const float fov = 2.0f * std::atan(1.0f / 4.0f) * 180.0f / float(M_PI);
   const CameraSpec cam{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, fov};
   Framebuffer fb(s.width, s.height);
-  RenderContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
-  RenderControl control;
+  PassContext ctx{&scene, Camera(cam, s.width, s.height), s, &fb};
+  RenderMonitor control;
   ASSERT_TRUE(render_image(build_accelerator(scene, AccelOptions{}), ctx, SchedOptions{}, control));
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 4; ++x) {

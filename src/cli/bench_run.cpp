@@ -79,10 +79,10 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
     rs.spp = job.integrator == Integrator::Path ? job.spp : 1;
     rs.packets = v.packets && job.integrator == Integrator::Ao;
     Framebuffer fb(job.width, job.height);
-    RenderContext ctx{&job.scene, Camera(job.camera, job.width, job.height), rs, &fb};
+    PassContext ctx{&job.scene, Camera(job.camera, job.width, job.height), rs, &fb};
     ctx.samples = {0, uint32_t(rs.spp)};  // one pass: the timing has no pass overhead
     std::atomic<bool> stop{false};
-    RenderControl control;
+    RenderMonitor control;
     control.cancel = &stop;
     SchedOptions so;
     so.strategy = v.sched;

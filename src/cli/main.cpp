@@ -48,14 +48,14 @@ int cmd_render(const RenderArgs& args) {
   const RenderSettings& settings = setup.settings;
   const Accelerator& accel = setup.accel;
 
-  RenderControl control;
+  RenderMonitor control;
   control.cancel = cancel;
   const auto t_render = std::chrono::steady_clock::now();
   ProgressBar progress(!args.quiet, pixel_samples(settings, args.frames), control.pixels_done, control.rays_done,
                        adaptive(settings) ? &control.active_pixels : nullptr,
                        uint64_t(settings.width) * uint64_t(settings.height));
   // Every pass a round of its own: checkpoints, and a complete image after the first on Ctrl-C.
-  const auto round = [&](const RenderContext& ctx, const std::vector<SampleRange>& passes) {
+  const auto round = [&](const PassContext& ctx, const std::vector<SampleRange>& passes) {
     return render_round(accel, ctx, passes, setup.sched, control);
   };
   const FrameSequence frames{args.output,       args.frames,    args.orbit,   args.checkpoint, args.exr,

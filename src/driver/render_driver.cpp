@@ -35,7 +35,7 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
     if (options.holds_image && seq.aovs.albedo) albedo.emplace(settings.width, settings.height);
     if (options.holds_image && seq.aovs.normal) normal.emplace(settings.width, settings.height);
     const Camera cam(frame_camera(camera, frame, seq.frames, seq.orbit_degrees), settings.width, settings.height);
-    RenderContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
+    PassContext ctx{&scene, cam, settings, fb ? &*fb : nullptr};
     ctx.albedo = albedo ? &*albedo : nullptr;
     ctx.normal = normal ? &*normal : nullptr;
     ctx.features = features ? &*features : nullptr;

@@ -39,7 +39,7 @@ struct FrameSequence {
 
 // Renders the passes of `round` of the frame `ctx` describes into ctx.framebuffer (null on a rank
 // that holds no image); false when stopped before the round finished.
-using RenderRound = std::function<bool(const RenderContext& ctx, const std::vector<SampleRange>& round)>;
+using RenderRound = std::function<bool(const PassContext& ctx, const std::vector<SampleRange>& round)>;
 
 struct DriveResult {
   int checkpoints = 0;

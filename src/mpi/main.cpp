@@ -68,7 +68,7 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
        .round_per_pass = args.checkpoint.has_value() || adaptive(prepared.settings),
        .cancel = nullptr,
        .denoiser = &denoiser},
-      [&](const RenderContext& ctx, const std::vector<SampleRange>& round) { return rank.render_round(ctx, round); },
+      [&](const PassContext& ctx, const std::vector<SampleRange>& round) { return rank.render_round(ctx, round); },
       [](const std::string& w) { say("tracer-mpi: warning: " + w); });
   rank.report_late_ranks();
   rank.report_ranks(driven.checkpoints);

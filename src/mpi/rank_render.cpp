@@ -22,9 +22,9 @@ namespace {
 
 // Renders the passes of `round` of one tile, in order, into `fb` (rank 0's image, or a window for
 // the tile) and, with --denoise, `features` (likewise).
-RayCounts render_one(const Accelerator& accel, const RenderContext& ctx, const std::vector<SampleRange>& round,
+RayCounts render_one(const Accelerator& accel, const PassContext& ctx, const std::vector<SampleRange>& round,
                      Framebuffer& fb, FeatureFilm* features, const Tile& tile) {
-  RenderContext c = ctx;
+  PassContext c = ctx;
   c.framebuffer = &fb;
   c.features = features;
   RayCounts counts;
@@ -69,7 +69,7 @@ void RankRender::count(const RayCounts& c, const Tile& t, uint32_t samples) {
 
 double RankRender::answer_bound() const { return 2.0 * std::max(rank_timeout_, 8.0 * slowest_tile_s_.load()); }
 
-bool RankRender::render_round(const RenderContext& ctx, const std::vector<SampleRange>& round) {
+bool RankRender::render_round(const PassContext& ctx, const std::vector<SampleRange>& round) {
   ++round_serial_;
   const uint32_t samples = round.back().first + round.back().count - round.front().first;
   // Adaptive sampling (a round per pass then): every rank knows whether this pass decides which
@@ -77,7 +77,7 @@ bool RankRender::render_round(const RenderContext& ctx, const std::vector<Sample
   const NoiseTarget target = noise_target(ctx.settings);
   const bool masks = target.threshold > 0.0f && round.front().first >= target.min_samples;
   if (session_.root()) {
-    RenderContext c = ctx;
+    PassContext c = ctx;
     if (masks) {
       active_.update(*ctx.framebuffer, target, round.front().first);
       c.active = &active_;
@@ -89,7 +89,7 @@ bool RankRender::render_round(const RenderContext& ctx, const std::vector<Sample
   return true;
 }
 
-void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples) {
+void RankRender::serve_round(const PassContext& ctx, const std::vector<SampleRange>& round, uint32_t samples) {
   Framebuffer& fb = *ctx.framebuffer;
   TileServer server(tiles_, threads_, round_serial_, watch_, ctx.active);
   std::exception_ptr own_failure;
@@ -133,7 +133,7 @@ void RankRender::serve_round(const RenderContext& ctx, const std::vector<SampleR
   for (size_t r = 0; r < given.size(); ++r) tiles_per_rank_[r] += given[r];
 }
 
-void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples,
+void RankRender::work_round(const PassContext& ctx, const std::vector<SampleRange>& round, uint32_t samples,
                             bool masks) {
   TileClient client(tiles_, round_serial_, masks);
   // Rank 0 answers a request at once, or, between rounds, once the round is in.
@@ -151,7 +151,7 @@ void RankRender::work_round(const RenderContext& ctx, const std::vector<SampleRa
       std::unique_ptr<Framebuffer> result;
       std::unique_ptr<FeatureFilm> features;  // --denoise: the tile's features, sent with its sums
       ActivePixels active;                    // this thread's tiles' blocks
-      RenderContext c = ctx;
+      PassContext c = ctx;
       if (masks) c.active = &active;
       double idle = 0;
       while (const std::optional<uint32_t> next = worker.next(finished, result.get(), features.get(), idle)) {

@@ -27,7 +27,7 @@ class RankRender {
 
   // One round of tile distribution of the frame `ctx` (driver::rounds_of): with --checkpoint one
   // pass, else every pass, each tile rendered whole and sent back once.
-  bool render_round(const RenderContext& ctx, const std::vector<SampleRange>& round);
+  bool render_round(const PassContext& ctx, const std::vector<SampleRange>& round);
   // Rank 0, after the last frame: names the ranks that were late, and ends the job (the image
   // written) if one stopped answering.
   void report_late_ranks();
@@ -36,9 +36,9 @@ class RankRender {
   void report_ranks(int checkpoints);
 
  private:
-  void serve_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples);
+  void serve_round(const PassContext& ctx, const std::vector<SampleRange>& round, uint32_t samples);
   // `masks`: rank 0 sends the blocks of adaptive sampling's active pixels with each tile.
-  void work_round(const RenderContext& ctx, const std::vector<SampleRange>& round, uint32_t samples, bool masks);
+  void work_round(const PassContext& ctx, const std::vector<SampleRange>& round, uint32_t samples, bool masks);
   void count(const RayCounts& c, const Tile& t, uint32_t samples);
   // How long a worker waits on rank 0 before taking it for stopped: twice the time rank 0 gives a
   // late rank (overdue_after()) and the rendering of that rank's tiles.

@@ -28,7 +28,7 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
 // `direct` (the hit's emission and lamp light) plus the ambient term, scaled by the fraction of
 // `si`'s AO rays that escape: the pixel's colour.
 template <class Accel>
-Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, int y, const SurfaceInteraction& si,
+Vec3 finish_with_ambient(const Accel& accel, const PassContext& ctx, int x, int y, const SurfaceInteraction& si,
                          Vec3 direct, RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
   float unoccluded = 1.0f;
@@ -74,7 +74,7 @@ Vec3 finish_with_ambient(const Accel& accel, const RenderContext& ctx, int x, in
 
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
 template <class Accel>
-Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
+Vec3 shade_hit(const Accel& accel, const PassContext& ctx, int x, int y, const Ray& primary, const Hit& hit,
                RayCounts& counts, uint32_t sample = 0) {
   if (!hit.valid()) return Vec3{0.0f};
   const SurfaceInteraction si = surface_interaction(ctx, primary, hit);
@@ -90,8 +90,8 @@ Vec3 shade_hit(const Accel& accel, const RenderContext& ctx, int x, int y, const
 struct AoIntegrator {
   using Streams = JitterStreams;
   template <class Accel>
-  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const SampleRng&,
-                RayCounts& counts, FirstHit*, GuideFeatures*) const {
+  Vec3 radiance(const Accel& accel, const PassContext& ctx, const PixelSample& ps, const SampleRng&, RayCounts& counts,
+                FirstHit*, GuideFeatures*) const {
     Hit hit;
     accel.intersect(ps.ray, hit);
     return shade_hit(accel, ctx, ps.x, ps.y, ps.ray, hit, counts, ps.index);
@@ -99,7 +99,7 @@ struct AoIntegrator {
 
   template <class Accel>
   requires PacketAccelerator<Accel>
-  void block_radiance(const Accel& accel, const RenderContext& ctx, const PixelBlock& block, Vec3* radiance,
+  void block_radiance(const Accel& accel, const PassContext& ctx, const PixelBlock& block, Vec3* radiance,
                       RayCounts& counts) const {
     Hit hits[kPacketSize];
     accel.intersect_packet(block.packet, hits);

@@ -45,7 +45,7 @@ inline bool lamp_sample_at(const Light& light, const SurfaceInteraction& si, Lig
 
 // `radiance` plus what every lamp gives `si`, added in the lamps' order.
 template <class Accel>
-Vec3 add_lamp_light(const Accel& accel, const RenderContext& ctx, const SurfaceInteraction& si, Vec3 radiance,
+Vec3 add_lamp_light(const Accel& accel, const PassContext& ctx, const SurfaceInteraction& si, Vec3 radiance,
                     RayCounts& counts) {
   for (const Light& light : ctx.scene->lights) {
     LightSample ls;
@@ -61,7 +61,7 @@ Vec3 add_lamp_light(const Accel& accel, const RenderContext& ctx, const SurfaceI
 // gets the answer it gets alone and each lane adds the lamps in the same order, so every
 // radiance[k] is the single-hit one.
 template <class Accel>
-void add_lamp_light(const Accel& accel, const RenderContext& ctx, const SurfaceInteraction* sis, uint32_t lanes,
+void add_lamp_light(const Accel& accel, const PassContext& ctx, const SurfaceInteraction* sis, uint32_t lanes,
                     Vec3* radiance, RayCounts& counts) {
   for (const Light& light : ctx.scene->lights) {
     RayPacket shadows;

@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "math/ray.hpp"
-#include "render/render_context.hpp"
+#include "render/pass_context.hpp"
 
 namespace tracer {
 
@@ -26,7 +26,7 @@ struct SurfaceInteraction {
   uint32_t tri, geomID;
 };
 
-inline SurfaceInteraction surface_interaction(const RenderContext& ctx, const Ray& ray, const Hit& hit) {
+inline SurfaceInteraction surface_interaction(const PassContext& ctx, const Ray& ray, const Hit& hit) {
   const Scene& scene = *ctx.scene;
   const Triangle& tri = scene.triangles[hit.tri];
   SurfaceInteraction si;

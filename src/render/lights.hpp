@@ -57,7 +57,7 @@ struct EnvironmentLight {
   Vec3 scale{0.0f};
   const EnvironmentMap* map = nullptr;  // null: uniform radiance `scale`
 
-  static EnvironmentLight of(const RenderContext& ctx) {
+  static EnvironmentLight of(const PassContext& ctx) {
     const EnvironmentMap& m = ctx.scene->environment_map;
     return {ctx.settings.environment, m.empty() ? nullptr : &m};
   }
@@ -84,7 +84,7 @@ struct EnvironmentLight {
 // lights, which no ray can hit, are each taken at every vertex (delta_lamps()).
 class LightSampler {
  public:
-  explicit LightSampler(const RenderContext& ctx)
+  explicit LightSampler(const PassContext& ctx)
       : scene_(ctx.scene),
         env_(EnvironmentLight::of(ctx)),
         p_env_(env_.black()                  ? 0.0f

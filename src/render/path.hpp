@@ -83,7 +83,7 @@ void add_sampled_light(const Accel& accel, const LightSampler& lights, const Sur
 // glass, with the albedo times what the specular bounces before it let through, so a reflection
 // is guided by what it reflects; where the path ends before such a vertex, the last vertex's.
 template <class Accel>
-Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const PathSampler& sampler, RayCounts& counts,
+Vec3 path_radiance(const Accel& accel, const PassContext& ctx, Ray ray, const PathSampler& sampler, RayCounts& counts,
                    FirstHit* first = nullptr, GuideFeatures* guide = nullptr) {
   const Scene& scene = *ctx.scene;
   const RenderSettings& s = ctx.settings;
@@ -172,7 +172,7 @@ Vec3 path_radiance(const Accel& accel, const RenderContext& ctx, Ray ray, const 
 struct PathIntegrator {
   using Streams = PathStreams;
   template <class Accel>
-  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const PathSampler& sampler,
+  Vec3 radiance(const Accel& accel, const PassContext& ctx, const PixelSample& ps, const PathSampler& sampler,
                 RayCounts& counts, FirstHit* first, GuideFeatures* guide) const {
     return path_radiance(accel, ctx, ps.ray, sampler, counts, first, guide);
   }

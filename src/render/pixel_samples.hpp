@@ -15,8 +15,8 @@
 #include "math/sobol.hpp"
 #include "parallel/tiles.hpp"
 #include "render/accel_concepts.hpp"
+#include "render/pass_context.hpp"
 #include "render/ray_counts.hpp"
-#include "render/render_context.hpp"
 
 namespace tracer {
 
@@ -92,7 +92,7 @@ struct PixelBlock {
 // An integrator: its sample streams and the radiance along a sample's camera ray. `first` and
 // `guide`, when not null, take what the --aov layers and the denoiser read of the sample.
 template <class I, class Accel>
-concept PixelIntegrator = requires(const I& i, const Accel& accel, const RenderContext& ctx, const PixelSample& ps,
+concept PixelIntegrator = requires(const I& i, const Accel& accel, const PassContext& ctx, const PixelSample& ps,
                                    const typename I::Streams::Sampler& sampler, RayCounts& counts) {
   { i.radiance(accel, ctx, ps, sampler, counts, (FirstHit*)nullptr, (GuideFeatures*)nullptr) } -> std::same_as<Vec3>;
 };
@@ -100,7 +100,7 @@ concept PixelIntegrator = requires(const I& i, const Accel& accel, const RenderC
 // radiance of each active lane into radiance[lane], each what radiance() gives its pixel.
 template <class I, class Accel>
 concept BlockIntegrator = PixelIntegrator<I, Accel> &&
-    requires(const I& i, const Accel& accel, const RenderContext& ctx, const PixelBlock& block, Vec3* radiance,
+    requires(const I& i, const Accel& accel, const PassContext& ctx, const PixelBlock& block, Vec3* radiance,
              RayCounts& counts) {
   i.block_radiance(accel, ctx, block, radiance, counts);
 };
@@ -110,7 +110,7 @@ concept BlockIntegrator = PixelIntegrator<I, Accel> &&
 // out non-finite (a float overflow on a degenerate path) adds black rather than poisoning it.
 template <class Integrator, class Accel>
 requires PixelIntegrator<Integrator, Accel>
-void render_pixels(const Integrator& integrator, const Accel& accel, const RenderContext& ctx, const Tile& tile,
+void render_pixels(const Integrator& integrator, const Accel& accel, const PassContext& ctx, const Tile& tile,
                    RayCounts& counts) {
   using Streams = typename Integrator::Streams;
   const RenderSettings& s = ctx.settings;

@@ -10,7 +10,7 @@ NoiseTarget noise_target(const RenderSettings& s) {
   return {s.noise_threshold, uint32_t(std::max(s.min_spp, 2)), s.exposure};
 }
 
-void choose_active_pixels(RenderContext& ctx, RenderControl& control) {
+void choose_active_pixels(PassContext& ctx, RenderMonitor& control) {
   const NoiseTarget target = noise_target(ctx.settings);
   if (target.threshold <= 0.0f) return;
   if (ctx.samples.first < target.min_samples) {
@@ -22,13 +22,14 @@ void choose_active_pixels(RenderContext& ctx, RenderControl& control) {
   ctx.active = &control.active;
 }
 
-bool render_image(const Accelerator& accel, const RenderContext& image, const SchedOptions& options,
-                  RenderControl& control) {
-  RenderContext ctx = image;
+bool render_image(const Accelerator& accel, const PassContext& image, const SchedOptions& options,
+                  RenderMonitor& control) {
+  PassContext ctx = image;
   choose_active_pixels(ctx, control);
   return parallel_for_tiles(
       ctx.framebuffer->width(), ctx.framebuffer->height(), options, control.cancel, [&](const Tile& tile) {
-        // The one place the accelerator variant is dispatched: once per tile, which is walked in
+        // The accelerator variant is dispatched once per tile (as tracer-mpi's rank_render does
+        // for the tiles it is handed, and the viewer for a click's one ray); the tile is walked in
         // pieces of kPieceWidth x kPacketEdge pixels (aligned to the tile, so packet blocks are the
         // same) with the cancel flag checked between them: a whole-row tile of the async and seq
         // schedulers or a --tile 4096 stops within moments of a Ctrl-C.
@@ -79,8 +80,8 @@ std::vector<SampleRange> sample_passes(const RenderSettings& settings) {
   return passes;
 }
 
-bool render_round(const Accelerator& accel, RenderContext ctx, const std::vector<SampleRange>& round,
-                  const SchedOptions& options, RenderControl& control) {
+bool render_round(const Accelerator& accel, PassContext ctx, const std::vector<SampleRange>& round,
+                  const SchedOptions& options, RenderMonitor& control) {
   for (const SampleRange& pass : round) {
     ctx.samples = pass;
     if (!render_image(accel, ctx, options, control)) return false;

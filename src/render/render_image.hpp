@@ -15,8 +15,9 @@
 
 namespace tracer {
 
-// Shared between the render, the caller (progress, cancellation) and tests.
-struct RenderControl {
+// What the caller watches and stops a render by, shared with the render and tests: the cancel
+// flag, progress and ray counters, a per-tile hook, adaptive sampling's active pixels.
+struct RenderMonitor {
   CancelFlag cancel = nullptr;           // set (e.g. by SIGINT) to stop at the next tile
   std::atomic<uint64_t> pixels_done{0};  // pixel samples, over all passes
   std::atomic<uint64_t> rays_done{0};
@@ -32,8 +33,8 @@ struct RenderControl {
 
 // Renders ctx.samples of every pixel into ctx.framebuffer with `accel`. Returns false if
 // cancelled before finishing (tiles not reached are left untouched).
-bool render_image(const Accelerator& accel, const RenderContext& ctx, const SchedOptions& options,
-                  RenderControl& control);
+bool render_image(const Accelerator& accel, const PassContext& ctx, const SchedOptions& options,
+                  RenderMonitor& control);
 
 // The passes of a render: settings.spp samples per pixel (ao and whitted: 1 by default) in
 // passes that double (1, 1, 2, 4, ... at most kMaxPassSamples), so a checkpoint or a stop finds
@@ -51,13 +52,13 @@ inline bool adaptive(const RenderSettings& settings) { return noise_target(setti
 // Before a pass of ctx.samples with adaptive sampling: decides from ctx.framebuffer (kept with
 // halves) which pixels the pass samples, into `control`, and points ctx.active at them. Does
 // nothing without adaptive sampling or before the minimum samples.
-void choose_active_pixels(RenderContext& ctx, RenderControl& control);
+void choose_active_pixels(PassContext& ctx, RenderMonitor& control);
 
 // The passes of `round` (some of sample_passes(), in order) of every pixel into ctx.framebuffer,
 // each by render_image(): what tracer render does with each round of the render driver. Returns
 // false if cancelled (the framebuffer then holds the finished passes plus whatever tiles of the
 // stopped one completed).
-bool render_round(const Accelerator& accel, RenderContext ctx, const std::vector<SampleRange>& round,
-                  const SchedOptions& options, RenderControl& control);
+bool render_round(const Accelerator& accel, PassContext ctx, const std::vector<SampleRange>& round,
+                  const SchedOptions& options, RenderMonitor& control);
 
 }  // namespace tracer

@@ -10,7 +10,7 @@
 namespace tracer {
 
 template <class Accel>
-RayCounts render_tile(const Accel& accel, const RenderContext& ctx, const Tile& tile) {
+RayCounts render_tile(const Accel& accel, const PassContext& ctx, const Tile& tile) {
   RayCounts counts;
   switch (ctx.settings.integrator) {
     case Integrator::Ao:

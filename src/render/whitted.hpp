@@ -15,7 +15,7 @@ namespace tracer {
 // images, with total internal reflection; nothing past max_depth bounces; the environment (--env,
 // --env-map) where nothing is hit. Diffuse surfaces take their light from the lights only.
 template <class Accel>
-Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& ray, int depth, RayCounts& counts,
+Vec3 whitted_radiance(const Accel& accel, const PassContext& ctx, const Ray& ray, int depth, RayCounts& counts,
                       RayCone cone = {}) {
   if (depth == 0) cone = RayCone{0.0f, ctx.camera.pixel_spread()};
   Hit hit;
@@ -67,8 +67,8 @@ Vec3 whitted_radiance(const Accel& accel, const RenderContext& ctx, const Ray& r
 struct WhittedIntegrator {
   using Streams = JitterStreams;
   template <class Accel>
-  Vec3 radiance(const Accel& accel, const RenderContext& ctx, const PixelSample& ps, const SampleRng&,
-                RayCounts& counts, FirstHit*, GuideFeatures*) const {
+  Vec3 radiance(const Accel& accel, const PassContext& ctx, const PixelSample& ps, const SampleRng&, RayCounts& counts,
+                FirstHit*, GuideFeatures*) const {
     return whitted_radiance(accel, ctx, ps.ray, 0, counts);
   }
 };

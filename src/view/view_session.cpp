@@ -238,11 +238,11 @@ bool ViewSession::render_preview(const Job& job, bool& skipped) {
   small.settings.height = std::max(1, (s.height + scale - 1) / scale);
   small.settings.spp = 1;
   Framebuffer fb(small.settings.width, small.settings.height);
-  RenderContext ctx{&scene_, Camera(job.camera, small.settings.width, small.settings.height), small.settings, &fb};
+  PassContext ctx{&scene_, Camera(job.camera, small.settings.width, small.settings.height), small.settings, &fb};
   ctx.samples = {0, 1};
   // Only a stop ends a preview: it is short, and interrupting it for the next move's would leave
   // a fast-moving camera with no frame at all.
-  RenderControl control;
+  RenderMonitor control;
   control.cancel = &stop_;
   const auto t0 = Clock::now();
   if (!render_image(accel_, ctx, sched_, control)) return false;
@@ -299,9 +299,9 @@ bool ViewSession::render_job(const Job& job) {
   }
   film_base_ = job.film_base;
   Framebuffer& fb = *film_;
-  RenderContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
+  PassContext ctx{&scene_, Camera(job.camera, s.width, s.height), s, &fb};
   ctx.features = job.denoise ? &*features_ : nullptr;
-  RenderControl control;
+  RenderMonitor control;
   const size_t tile_count = tiles_for(s.width, s.height, sched_).size();
   const auto t_start = Clock::now();
   size_t tiles_done = 0;

@@ -1,5 +1,6 @@
-// What every tile of a render shares (RenderContext): the scene, the camera, the settings, the
-// films it adds to, and the samples this pass takes.
+// What every tile of one pass of a render shares (PassContext): the scene, the camera, the
+// settings, the films it adds to, and the samples the pass takes. (RenderArgs are the flags,
+// RenderSettings what they make of the image, RenderMonitor what the caller watches and stops.)
 #pragma once
 
 #include <cstdint>
@@ -20,7 +21,7 @@ struct SampleRange {
 };
 
 // Everything one tile needs; shared read-only by all workers except the disjoint framebuffer pixels.
-struct RenderContext {
+struct PassContext {
   const Scene* scene = nullptr;
   Camera camera;
   RenderSettings settings;
