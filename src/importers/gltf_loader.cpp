@@ -13,8 +13,11 @@
 #include "base/read_input.hpp"
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
+#include "importers/gltf_counts.hpp"
 #include "importers/gltf_document.hpp"
 #include "importers/gltf_materials.hpp"
+#include "importers/gltf_primitive.hpp"
+#include "importers/gltf_viewpoints.hpp"
 #include "importers/indexed_mesh.hpp"
 #include "scene/scene_info.hpp"
 #include "scene/value_limits.hpp"
@@ -24,6 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace tg = tinygltf;
+using gltf::kSaturated;
+using gltf::Placed;
+using gltf::Summary;
 
 // The most triangles a scene may hold once its instances are expanded: a node tree that reuses a
 // mesh 2^30 times in a few hundred bytes must fail, not exhaust memory (33.5M triangles is about
@@ -161,16 +167,6 @@ class GltfScene {
     return chosen;
   }
 
-  // What node `index` and its descendants place: triangles and primitives (each a geometry of
-  // the scene). Memoised, saturating at kSaturated.
-  struct Placed {
-    uint64_t triangles = 0, primitives = 0, nodes = 0;  // nodes: visits of the expansion
-    void add(const Placed& o) {
-      triangles = std::min(triangles + o.triangles, kSaturated);
-      primitives = std::min(primitives + o.primitives, kSaturated);
-      nodes = std::min(nodes + o.nodes, kSaturated);
-    }
-  };
   bool uses_default_material() const {
     for (const tg::Mesh& m : model_.meshes)
       for (const tg::Primitive& p : m.primitives)
@@ -192,27 +188,6 @@ class GltfScene {
     return roots;
   }
 
-  // A subtree's sums for tracer info, in the frame of its node's parent.
-  struct Summary {
-    Placed placed;
-    uint64_t vertices = 0, degenerate = 0, emissive = 0;
-    Aabb box;
-    bool listed = false;  // holds a camera or a point light
-    void add(const Summary& o, const Affine& to) {
-      placed.add(o.placed);
-      vertices = std::min(vertices + o.vertices, kSaturated);
-      degenerate = std::min(degenerate + o.degenerate, kSaturated);
-      emissive = std::min(emissive + o.emissive, kSaturated);
-      if (!o.box.empty()) {
-        for (int c = 0; c < 8; ++c) {
-          box.extend(to.point(
-              Vec3{c & 1 ? o.box.hi.x : o.box.lo.x, c & 2 ? o.box.hi.y : o.box.lo.y, c & 4 ? o.box.hi.z : o.box.lo.z}));
-        }
-      }
-      listed = listed || o.listed;
-    }
-  };
-
   Summary summarize_node(int index, std::vector<uint64_t>& state, std::vector<Summary>& sums, int depth) {
     throw_if_cancelled(cancel_);
     check_node(index, depth);
@@ -230,23 +205,16 @@ class GltfScene {
       const tg::Mesh& m = model_.meshes[size_t(node.mesh)];
       for (size_t k = 0; k < m.primitives.size(); ++k) {
         auto [it, fresh] = meshes_.try_emplace({node.mesh, int(k)});
-        if (fresh) it->second = primitive_mesh(m.primitives[k], primitive_name(node.mesh, k));
+        if (fresh)
+          it->second = gltf::primitive_mesh(model_, name_, warnings_, m.primitives[k], primitive_name(node.mesh, k));
         if (!it->second) continue;
-        const IndexedMesh& mesh = *it->second;
-        ++here.placed.primitives;
-        here.placed.triangles += mesh.triangle_count();
-        here.vertices += mesh.positions.size();
-        for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-          const uint32_t* ix = &mesh.indices[3 * t];
-          if (Triangle{mesh.positions[ix[0]], mesh.positions[ix[1]], mesh.positions[ix[2]]}.degenerate())
-            ++here.degenerate;
-        }
-        for (const Vec3& v : mesh.positions) here.box.extend(v);
         const int material = m.primitives[k].material;
+        bool emissive = false;
         if (material >= 0 && size_t(material) < model_.materials.size()) {
           const std::vector<double>& e = model_.materials[size_t(material)].emissiveFactor;
-          if (e.size() >= 3 && (e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0)) ++here.emissive;
+          emissive = e.size() >= 3 && (e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0);
         }
+        here.add(gltf::summary_of(*it->second, emissive), Affine{});
       }
     }
     here.listed = node.camera >= 0 || gltf::extension(node.extensions, "KHR_lights_punctual");
@@ -299,7 +267,6 @@ class GltfScene {
   }
 
   static constexpr uint64_t kUncounted = ~uint64_t(0), kCounting = ~uint64_t(0) - 1;
-  static constexpr uint64_t kSaturated = uint64_t(1) << 62;  // counts stop growing here
 
   // Whether any primitive has the attribute (the scene then keeps it for every triangle).
   bool any_attribute(const char* name) const {
@@ -371,81 +338,6 @@ class GltfScene {
   }
 
   // One primitive as an indexed triangle mesh (its index list made triangles whatever its mode).
-  std::optional<IndexedMesh> primitive_mesh(const tg::Primitive& p, const std::string& what) {
-    const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
-    if (mode < TINYGLTF_MODE_TRIANGLES || mode > TINYGLTF_MODE_TRIANGLE_FAN) {
-      warnings_.add(what + ": points and lines are not rendered (mode " + std::to_string(mode) + ")");
-      return std::nullopt;
-    }
-    if (!p.targets.empty()) warnings_.add(what + ": morph targets not applied");
-    const auto pos = p.attributes.find("POSITION");
-    if (pos == p.attributes.end()) throw error(what + ": no POSITION attribute");
-    IndexedMesh mesh;
-    const gltf::Elements positions = gltf::vectors(model_, pos->second, 3, where(what + " POSITION"));
-    mesh.positions.resize(positions.count);
-    for (size_t i = 0; i < positions.count; ++i) {
-      const Vec3 v{positions.get(i, 0), positions.get(i, 1), positions.get(i, 2)};
-      if (!is_finite(v) || std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kMaxCoordinate) {
-        throw error(what + " POSITION: vertex " + std::to_string(i) + " is not finite or lies beyond +-" +
-                    kMaxCoordinateText);
-      }
-      mesh.positions[i] = v;
-    }
-    if (const auto n = p.attributes.find("NORMAL"); n != p.attributes.end()) {
-      const gltf::Elements normals = gltf::vectors(model_, n->second, 3, where(what + " NORMAL"));
-      if (normals.count != positions.count) throw error(what + ": NORMAL and POSITION counts differ");
-      mesh.normals.resize(normals.count);
-      for (size_t i = 0; i < normals.count; ++i) {
-        const Vec3 v{normals.get(i, 0), normals.get(i, 1), normals.get(i, 2)};
-        mesh.normals[i] = is_finite(v) ? v : Vec3{0.0f};
-      }
-    }
-    if (const auto t = p.attributes.find("TEXCOORD_0"); t != p.attributes.end()) {
-      const gltf::Elements uvs = gltf::vectors(model_, t->second, 2, where(what + " TEXCOORD_0"));
-      if (uvs.count != positions.count) throw error(what + ": TEXCOORD_0 and POSITION counts differ");
-      mesh.uvs.resize(uvs.count);
-      for (size_t i = 0; i < uvs.count; ++i) {
-        const float u = uvs.get(i, 0), v = uvs.get(i, 1);
-        // glTF's v runs down the image, OBJ's (and tracer's) up.
-        mesh.uvs[i] = std::isfinite(u) && std::isfinite(v) ? Vec2{u, 1.0f - v} : Vec2{};
-      }
-    }
-    if (p.attributes.count("COLOR_0")) warnings_.add("vertex colours (COLOR_0) not used");
-    std::vector<uint32_t> list;
-    if (p.indices >= 0) {
-      const gltf::Elements ix = gltf::elements(model_, p.indices, where(what + " indices"));
-      if (ix.components != 1 || (ix.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-                                 ix.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-                                 ix.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
-        throw error(what + " indices: not unsigned integer scalars");
-      }
-      list.resize(ix.count);
-      for (size_t i = 0; i < ix.count; ++i) {
-        list[i] = ix.index(i);
-        if (list[i] >= positions.count) {
-          throw error(what + ": index " + std::to_string(list[i]) + " out of range (" +
-                      std::to_string(positions.count) + " vertices)");
-        }
-      }
-    } else {
-      if (positions.count > UINT32_MAX) throw error(what + ": more than 2^32 vertices");
-      list.resize(positions.count);
-      for (size_t i = 0; i < list.size(); ++i) list[i] = uint32_t(i);
-    }
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
-      if (list.size() % 3 != 0) warnings_.add(what + ": index count not a multiple of 3 (the rest ignored)");
-      list.resize(list.size() / 3 * 3);
-      mesh.indices = std::move(list);
-    } else {
-      for (size_t i = 0; i + 2 < list.size(); ++i) {
-        const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
-        const uint32_t a = strip ? list[i + (i & 1)] : list[0], b = strip ? list[i + 1 - (i & 1)] : list[i + 1];
-        mesh.indices.insert(mesh.indices.end(), {a, b, list[i + 2]});
-      }
-    }
-    return mesh;
-  }
-
   std::string primitive_name(int mesh, size_t k) const {
     const std::string& name = model_.meshes[size_t(mesh)].name;
     return "mesh " + std::to_string(mesh) + (name.empty() ? "" : " " + in_quotes(name)) + " primitive " +
@@ -463,7 +355,7 @@ class GltfScene {
       const tg::Primitive& p = m.primitives[k];
       const std::string what = primitive_name(node.mesh, k);
       auto [it, fresh] = meshes_.try_emplace({node.mesh, int(k)});
-      if (fresh) it->second = primitive_mesh(p, what);
+      if (fresh) it->second = gltf::primitive_mesh(model_, name_, warnings_, p, what);
       if (!it->second) continue;
       const IndexedMesh& mesh = *it->second;
       if (scene_.triangles.size() + mesh.triangle_count() > kMaxTriangles) {
@@ -484,51 +376,13 @@ class GltfScene {
   }
 
   void add_camera(int index, const Affine& world) {
-    if (size_t(index) >= model_.cameras.size()) throw error("camera " + std::to_string(index) + " does not exist");
-    const tg::Camera& c = model_.cameras[size_t(index)];
-    if (c.type != "perspective") {
-      warnings_.add("camera " + std::to_string(index) + " is " + in_quotes(c.type) +
-                    ": only perspective cameras are used");
-      return;
-    }
-    const double yfov = c.perspective.yfov, degrees = yfov * 180.0 / std::numbers::pi;
-    if (!(degrees >= kMinFovDegrees && degrees <= kMaxFovDegrees)) {
-      throw error("camera " + std::to_string(index) + ": yfov " + format_number(yfov) + " (" + format_number(degrees) +
-                  " degrees) is not in [" + format_number(kMinFovDegrees) + ", " + format_number(kMaxFovDegrees) +
-                  "] degrees, the field of view every camera of tracer's is held to");
-    }
-    CameraSpec spec;
-    spec.eye = world.point(Vec3{0.0f});
-    const Vec3 forward = world.vector(Vec3{0.0f, 0.0f, -1.0f}), up = world.vector(Vec3{0.0f, 1.0f, 0.0f});
-    const float len = length(forward);
-    if (!(len > 0.0f) || !std::isfinite(len) || !(length(cross(forward, up)) > 0.0f)) {
-      throw error("camera " + std::to_string(index) + ": its node's transform collapses the view direction");
-    }
-    spec.look = spec.eye + forward / len;
-    spec.up = normalize(up);
-    spec.fov_degrees = float(yfov * 180.0 / std::numbers::pi);
-    scene_.cameras.push_back(spec);
+    if (std::optional<CameraSpec> c = gltf::camera_of(model_, name_, warnings_, index, world))
+      scene_.cameras.push_back(*c);
   }
 
   void add_light(const tg::Value& ext, const Affine& world) {
-    const int index = int(gltf::number(&ext, "light", -1.0));
-    if (index < 0 || size_t(index) >= model_.lights.size())
-      throw error("light " + std::to_string(index) + " does not exist");
-    const tg::Light& l = model_.lights[size_t(index)];
-    if (l.type != "point") {
-      warnings_.add("light " + std::to_string(index) + " is a " + in_quotes(l.type) +
-                    " light: only point lights are used");
-      return;
-    }
-    Light light;
-    light.position = world.point(Vec3{0.0f});
-    light.power = gltf::vec3_of(l.color, Vec3{1.0f}) * float(l.intensity);
-    if (!is_finite(light.position) || !is_finite(light.power) || light.power.x < 0.0f || light.power.y < 0.0f ||
-        light.power.z < 0.0f || max_component(light.power) > kMaxLightIntensity) {
-      throw error("light " + std::to_string(index) + ": position or intensity not finite, negative or above " +
-                  format_number(kMaxLightIntensity) + " (--light-intensity's limit)");
-    }
-    scene_.lights.push_back(light);
+    if (std::optional<Light> l = gltf::point_light_of(model_, name_, warnings_, ext, world))
+      scene_.lights.push_back(*l);
   }
 
   const tg::Model& model_;
