@@ -744,5 +744,16 @@ TEST_F(Cli, CtrlCWhileTheSceneIsStillArrivingStopsWithoutAnImage) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// --simd-target chooses the tree's kernels (its name says which), and the image is the same.
+TEST_F(Cli, TheSimdTargetIsTheAcceleratorsAndChangesNoPixel) {
+  const std::string common = "render --integrator ao --width 40 --height 30 -q --stats --exr float -o ";
+  const test::CommandResult sse4 = test::run_tracer(common + dir_ + "/sse4.exr --simd-target sse4");
+  ASSERT_EQ(sse4.exit_code, 0) << sse4.output;
+  EXPECT_NE(sse4.output.find("bvh8-SSE4"), std::string::npos) << sse4.output;
+  const test::CommandResult best = test::run_tracer(common + dir_ + "/best.exr");
+  ASSERT_EQ(best.exit_code, 0) << best.output;
+  EXPECT_EQ(slurp_text(dir_ + "/sse4.exr"), slurp_text(dir_ + "/best.exr"));
+}
+
 }  // namespace
 }  // namespace tracer

@@ -90,8 +90,9 @@ void add_settings(CLI::App& app, RenderArgs& args, std::initializer_list<Setting
 // Checks every row's range, then the rules that tie flags together; throws UsageError naming the
 // flag. Changes nothing.
 void check_settings(const RenderArgs& args);
-// Rows whose value is given but whose integrators do not include args.settings.integrator are
-// reset; rows that apply and the viewer does not set (no key) take their value from `launched`.
+// Rows that are off until given (an optional, a toggle, a name) and do not apply to
+// args.integrator are reset, so check_settings() accepts the switch; rows that apply and the
+// viewer does not set (no key) take their value from `launched`.
 void follow_integrator(RenderArgs& args, const RenderArgs& launched);
 // The `tracer render` command of `args`: every row whose value differs from a default render's,
 // in the table's order, shell-quoted.

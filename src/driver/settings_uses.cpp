@@ -99,8 +99,9 @@ void check_settings(const RenderArgs& a) {
 void follow_integrator(RenderArgs& a, const RenderArgs& launched) {
   const RenderArgs defaults;
   for (const Setting& s : settings_table()) {
+    // As check_settings refuses them: only a flag that is off until given is dropped.
     if (!s.applies.has(a.integrator)) {
-      s.copy(a, defaults);
+      if (!s.text(defaults)) s.copy(a, defaults);
     } else if (s.key.empty() && !s.applies.is_all()) {
       s.copy(a, launched);
     }
