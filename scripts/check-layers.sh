@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 
 # folder:layer, lowest first; accel's sub-layers (kernels, bvh, wide_bvh, builders, then accel/
 # itself) within its layer 3.
-layers="base:0 math:1 scene:2 parallel:2 importers:3 film:3 accel:3 io:4 shade:4 denoise:4 render:5 driver:6 view:7 mpi:7 cli:8"
+layers="base:0 math:1 scene:2 parallel:2 importers:3 film:3 accel:3 io:4 shade:4 denoise:4 render:5 frontend:6 view:7 mpi:7 cli:8"
 sublayers="accel/kernels:0 accel/bvh:1 accel/wide_bvh:2 accel/builders:3 accel:4"
 declare -A rank
 for entry in $layers; do rank[${entry%%:*}]=$((${entry##*:} * 10)); done

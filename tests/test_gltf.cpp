@@ -9,8 +9,8 @@
 #include <numbers>
 #include <string>
 
-#include "driver/render_args.hpp"
-#include "driver/scene_setup.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/scene_setup.hpp"
 #include "importers/gltf_loader.hpp"
 #include "importers/obj_loader.hpp"
 #include "importers/ply_loader.hpp"
@@ -557,9 +557,9 @@ void expect_same_geometry(const Scene& a, const Scene& b, bool uv_rounding) {
 }
 
 Scene load_as_user_does(const std::string& path) {
-  driver::SceneArgs args;
+  frontend::SceneArgs args;
   args.scene = path;
-  return driver::load_scene(args, /*quiet=*/true);
+  return frontend::load_scene(args, /*quiet=*/true);
 }
 
 class Conversions : public ::testing::TestWithParam<const char*> {};

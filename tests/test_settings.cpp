@@ -10,15 +10,15 @@
 #include <vector>
 
 #include "base/errors.hpp"
-#include "driver/render_args.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/settings_table.hpp"
 #include "view/view_state.hpp"
 
 namespace tracer {
 namespace {
 
-using driver::RenderArgs;
-using driver::Setting;
+using frontend::RenderArgs;
+using frontend::Setting;
 
 // The words of a command line (no quoting needed: the test's values have no spaces).
 std::vector<std::string> words_of(const std::string& command) {
@@ -34,7 +34,7 @@ RenderArgs parsed(const std::string& command) {
   words.erase(words.begin(), words.begin() + 2);
   CLI::App app;
   RenderArgs args;
-  driver::add_render_options(app, args);
+  frontend::add_render_options(app, args);
   std::vector<std::string> reversed(words.rbegin(), words.rend());
   app.parse(reversed);
   return args;
@@ -80,36 +80,37 @@ RenderArgs unusual() {
 }
 
 void expect_same_rows(const RenderArgs& a, const RenderArgs& b) {
-  for (const Setting& s : driver::settings_table()) {
+  for (const Setting& s : frontend::settings_table()) {
     EXPECT_EQ(s.text(a), s.text(b)) << s.flag();
   }
 }
 
 TEST(SettingsTable, TheCopiedCommandParsesBackToTheSameValues) {
   const RenderArgs a = unusual();
-  const std::string command = driver::render_command(a);
+  const std::string command = frontend::render_command(a);
   SCOPED_TRACE(command);
   expect_same_rows(parsed(command), a);
-  EXPECT_NO_THROW(driver::validate(a));
+  EXPECT_NO_THROW(frontend::validate(a));
 }
 
 TEST(SettingsTable, EveryFlagThatDefinesTheImageIsComparedBetweenRanks) {
-  const std::string lines = driver::settings_lines(unusual(), {driver::Role::Image, driver::Role::Work});
-  for (const Setting& s : driver::settings_table()) {
-    const bool compared = s.role == driver::Role::Image || s.role == driver::Role::Work;
+  const std::string lines = frontend::settings_lines(unusual(), {frontend::Role::Image, frontend::Role::Work});
+  for (const Setting& s : frontend::settings_table()) {
+    const bool compared = s.role == frontend::Role::Image || s.role == frontend::Role::Work;
     EXPECT_EQ(lines.find("\n" + s.flag() + " ") != std::string::npos || lines.rfind(s.flag() + " ", 0) == 0, compared)
         << s.flag();
   }
   // Two renders that differ in one such flag differ in their lines.
   RenderArgs b = unusual();
   b.settings.max_depth = 4;
-  EXPECT_NE(driver::settings_lines(b, {driver::Role::Image}), driver::settings_lines(unusual(), {driver::Role::Image}));
-  EXPECT_FALSE(driver::same_settings(b, unusual(), {driver::Role::Image}));
-  EXPECT_TRUE(driver::same_settings(b, unusual(), {driver::Role::Image}, {"--max-depth"}));
+  EXPECT_NE(frontend::settings_lines(b, {frontend::Role::Image}),
+            frontend::settings_lines(unusual(), {frontend::Role::Image}));
+  EXPECT_FALSE(frontend::same_settings(b, unusual(), {frontend::Role::Image}));
+  EXPECT_TRUE(frontend::same_settings(b, unusual(), {frontend::Role::Image}, {"--max-depth"}));
 }
 
 TEST(SettingsTable, EveryRowHasHelpAndItsIntegratorsSayWhereItApplies) {
-  for (const Setting& s : driver::settings_table()) {
+  for (const Setting& s : frontend::settings_table()) {
     EXPECT_FALSE(s.help.empty()) << s.flag();
     EXPECT_EQ(s.flag().rfind("--", 0), 0u) << s.names;
     if (!s.applies.is_all()) {
@@ -123,35 +124,35 @@ TEST(SettingsTable, AFlagGivenToAnIntegratorThatIgnoresItIsRefused) {
   a.integrator = Integrator::Ao;
   a.denoise = true;
   try {
-    driver::validate(a);
+    frontend::validate(a);
     ADD_FAILURE() << "--denoise with ao accepted";
   } catch (const UsageError& e) {
     EXPECT_EQ(std::string(e.what()), "--denoise: only for --integrator path");
   }
   a.denoise = false;
   a.env = Vec3{1.0f};
-  EXPECT_THROW(driver::validate(a), UsageError);  // --env: path or whitted
+  EXPECT_THROW(frontend::validate(a), UsageError);  // --env: path or whitted
   a.integrator = Integrator::Whitted;
-  EXPECT_NO_THROW(driver::validate(a));
+  EXPECT_NO_THROW(frontend::validate(a));
   // A flag with a default value (--max-depth) only says so in its help.
   a.integrator = Integrator::Ao;
   a.env.reset();
   a.settings.max_depth = 2;
-  EXPECT_NO_THROW(driver::validate(a));
+  EXPECT_NO_THROW(frontend::validate(a));
 }
 
 TEST(SettingsTable, ASwitchOfIntegratorDropsAndRestoresWhatAppliesToIt) {
   RenderArgs launched = unusual();
   RenderArgs a = launched;
   a.integrator = Integrator::Ao;
-  driver::follow_integrator(a, launched);
+  frontend::follow_integrator(a, launched);
   EXPECT_FALSE(a.noise_threshold);
   EXPECT_FALSE(a.denoise);
   EXPECT_FALSE(a.env);
   EXPECT_EQ(a.settings.max_depth, 3);  // has a default: kept, as the page shows it
-  EXPECT_NO_THROW(driver::validate(a));
+  EXPECT_NO_THROW(frontend::validate(a));
   a.integrator = Integrator::Path;
-  driver::follow_integrator(a, launched);
+  frontend::follow_integrator(a, launched);
   expect_same_rows(a, launched);
 }
 
@@ -160,7 +161,7 @@ TEST(SettingsTable, TheViewersStateReadsBackToTheSameValues) {
   view::StateFields fields{RenderArgs{}, true, std::nullopt};
   fields.args.settings.width = 64;  // within the viewer's largest side
   view::read_change(view::state_fields(a), fields, a);
-  for (const Setting& s : driver::settings_table()) {
+  for (const Setting& s : frontend::settings_table()) {
     if (!s.key.empty()) {
       EXPECT_EQ(s.text(fields.args), s.text(a)) << s.key;
     }

@@ -18,8 +18,8 @@
 #include <sstream>
 #include <thread>
 
-#include "driver/render_options.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/settings_table.hpp"
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
@@ -43,7 +43,7 @@ class ViewServerTest : public ::testing::Test {
     args_.settings.height = 48;
     args_.spp = 4;
     args_.threads = 2;
-    accel_ = build_accelerator(scene_, driver::accel_options_for(args_));
+    accel_ = build_accelerator(scene_, frontend::accel_options_for(args_));
     session_ = std::make_unique<view::ViewSession>(scene_, accel_, args_);
     server_ = std::make_unique<view::ViewServer>(*session_, "0123456789abcdef0123456789abcdef");
     port_ = server_->bind("127.0.0.1", 0);
@@ -83,7 +83,7 @@ class ViewServerTest : public ::testing::Test {
   }
 
   Scene scene_;
-  driver::RenderArgs args_;
+  frontend::RenderArgs args_;
   Accelerator accel_;
   std::unique_ptr<view::ViewSession> session_;
   std::unique_ptr<view::ViewServer> server_;
@@ -176,13 +176,13 @@ TEST_F(ViewServerTest, ChangesRestartTheAccumulationExposureRetonesAoOnly) {
 // them (its copied command too) and back to path tracing with them.
 TEST(ViewSession, AdaptiveFlagsFollowTheIntegrator) {
   const Scene scene = make_cornell_box();
-  driver::RenderArgs args;
+  frontend::RenderArgs args;
   args.settings.width = 16;
   args.settings.height = 12;
   args.spp = 32;
   args.noise_threshold = 0.02;
   args.min_spp = 8;
-  const Accelerator accel = build_accelerator(scene, driver::accel_options_for(args));
+  const Accelerator accel = build_accelerator(scene, frontend::accel_options_for(args));
   view::ViewSession session(scene, accel, args);
   const std::string launched = session.state()["command"];
   EXPECT_NE(launched.find("--noise-threshold 0.02 --min-spp 8"), std::string::npos) << launched;
@@ -362,7 +362,7 @@ TEST_F(ViewServerTest, EventStreamsGetTheNewestFrameEachSeveralAtOnce) {
 // The copied command is the settings table's: every flag whose value differs from a default
 // render's, in the table's order, each float as the shortest text that reads back the same.
 TEST(ViewCommand, CopiedCommandSaysWhatDiffersFromADefaultRender) {
-  driver::RenderArgs a;
+  frontend::RenderArgs a;
   a.scene.scene = "my scene.obj";
   a.scene.lights = {Vec3{0, 1, 0}, Vec3{2, 0.1f, 0}};
   a.accel = AccelKind::Bvh;
@@ -376,13 +376,13 @@ TEST(ViewCommand, CopiedCommandSaysWhatDiffersFromADefaultRender) {
   a.integrator = Integrator::Ao;
   a.packets = false;
   a.threads = 2;
-  EXPECT_EQ(driver::render_command(a),
+  EXPECT_EQ(frontend::render_command(a),
             "tracer render --scene 'my scene.obj' --light 0,1,0 --light 2,0.1,0 --width 320 --height 200 "
             "--eye 1,2,3 --look 0,0,0 --up 0,1,0 --fov 45.3 --integrator ao --spp 16 --accel bvh --no-packets "
             "--threads 2");
-  EXPECT_EQ(driver::render_command(driver::RenderArgs{}), "tracer render");
-  EXPECT_EQ(driver::shell_quote("it's"), "'it'\\''s'");
-  EXPECT_EQ(driver::shell_quote(""), "''");
+  EXPECT_EQ(frontend::render_command(frontend::RenderArgs{}), "tracer render");
+  EXPECT_EQ(frontend::shell_quote("it's"), "'it'\\''s'");
+  EXPECT_EQ(frontend::shell_quote(""), "''");
 }
 
 // A raw connection to the viewer: what a browser, a script or an attacker sends, byte for byte.

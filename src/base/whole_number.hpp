@@ -1,4 +1,4 @@
-// The grammar of a number that is a whole word: a flag's value (driver/parse.hpp, the settings
+// The grammar of a number that is a whole word: a flag's value (frontend/parse.hpp, the settings
 // table) and a field of views.tsv. std::from_chars over all of the word: an optional '-', digits,
 // a point, an exponent, inf and nan; no '+', no spaces, no hex, nothing after. It differs on
 // purpose from the two file grammars: OBJ coordinates (importers/obj_numbers.hpp) and MTL values

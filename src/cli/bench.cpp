@@ -12,11 +12,11 @@
 #include "cli/bench_catalogue.hpp"
 #include "cli/bench_report.hpp"
 #include "cli/bench_run.hpp"
-#include "driver/output_checks.hpp"
-#include "driver/parse.hpp"
-#include "driver/render_args.hpp"
-#include "driver/render_options.hpp"
-#include "driver/scene_setup.hpp"
+#include "frontend/output_checks.hpp"
+#include "frontend/parse.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/scene_setup.hpp"
 #include "importers/scene_file.hpp"
 #include "io/image_io.hpp"
 #include "parallel/thread_count.hpp"
@@ -25,7 +25,7 @@
 
 namespace tracer::cli {
 
-using namespace driver;  // the flags both binaries share
+using namespace frontend;  // the flags both binaries share
 using Clock = std::chrono::steady_clock;
 
 void add_bench_options(CLI::App& app, BenchArgs& a) {

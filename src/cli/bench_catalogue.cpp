@@ -4,11 +4,11 @@
 #include <filesystem>
 
 #include "base/errors.hpp"
-#include "driver/parse.hpp"
+#include "frontend/parse.hpp"
 
 namespace tracer::cli {
 
-using namespace driver;
+using namespace frontend;
 
 const std::vector<Variant>& all_variants() {
   static const std::vector<Variant> v = {

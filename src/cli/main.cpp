@@ -16,22 +16,22 @@
 #include "base/errors.hpp"
 #include "base/stopwatch.hpp"
 #include "cli/bench.hpp"
-#include "driver/prepare_render.hpp"
-#include "driver/progress.hpp"
-#include "driver/render_args.hpp"
-#include "driver/render_driver.hpp"
-#include "driver/render_options.hpp"
-#include "driver/render_stats.hpp"
-#include "driver/scene_setup.hpp"
-#include "driver/settings_table.hpp"
-#include "driver/signals.hpp"
+#include "frontend/prepare_render.hpp"
+#include "frontend/progress.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/render_driver.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/render_stats.hpp"
+#include "frontend/scene_setup.hpp"
+#include "frontend/settings_table.hpp"
+#include "frontend/signals.hpp"
 #include "io/image_compare.hpp"
 #include "io/image_io.hpp"
 #include "view/view_command.hpp"
 
 namespace tracer::cli {
 
-using namespace driver;  // the flags, signals and statistics both binaries share
+using namespace frontend;  // the flags, signals and statistics both binaries share
 
 namespace {
 
@@ -142,7 +142,7 @@ int cmd_compare(const std::string& a, const std::string& b, std::optional<float>
 int main(int argc, char** argv) {
   using namespace tracer;
   using namespace tracer::cli;
-  using namespace tracer::driver;
+  using namespace tracer::frontend;
   install_stop_handlers();  // first: see signals.hpp
   CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ, glTF 2.0 and PLY scenes"};
   app.require_subcommand(1);

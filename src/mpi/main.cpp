@@ -14,10 +14,10 @@
 #include <utility>
 #include <vector>
 
-#include "driver/render_args.hpp"
-#include "driver/render_driver.hpp"
-#include "driver/render_options.hpp"
-#include "driver/signals.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/render_driver.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/signals.hpp"
 #include "mpi/mpi_session.hpp"
 #include "mpi/phase_watch.hpp"
 #include "mpi/rank_render.hpp"
@@ -36,9 +36,9 @@ constexpr const char* kStopMessage =
 
 // `parse_error`: this rank's flags did not parse (exit code 2 and the message); it still joins the
 // first collective, so rank 0 can name it and end the job instead of waiting for it.
-int run(const driver::RenderArgs& args, MpiSession& session, const std::string& parse_error, double rank_timeout,
+int run(const frontend::RenderArgs& args, MpiSession& session, const std::string& parse_error, double rank_timeout,
         PhaseWatch& watch_phase) {
-  driver::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
+  frontend::install_immediate_stop_handlers(session.root() ? kStopMessage : nullptr);
   RankSetup setup;  // in place: the accelerator points into the scene
   if (parse_error.empty()) {
     set_up(setup, args, session);
@@ -51,17 +51,17 @@ int run(const driver::RenderArgs& args, MpiSession& session, const std::string& 
   if (agreement.verdict != 0) {
     // The first rank to exit non-zero makes mpirun stop the others with SIGTERM: rank 0 has said
     // what is wrong, so that signal needs no second message.
-    driver::install_immediate_stop_handlers(nullptr);
+    frontend::install_immediate_stop_handlers(nullptr);
     return agreement.verdict;
   }
-  const driver::PreparedRender& prepared = *setup.prepared;
+  const frontend::PreparedRender& prepared = *setup.prepared;
   RankRender rank(prepared, args, session, std::move(agreement.threads), rank_timeout, watch_phase);
   // Signals end a rank at once (install_immediate_stop_handlers): no round is ever stopped.
-  const driver::FrameSequence frames{args.output, args.frames, args.orbit,   args.checkpoint, args.exr,
-                                     false,       {},          args.denoise, args.simd_target};
+  const frontend::FrameSequence frames{args.output, args.frames, args.orbit,   args.checkpoint, args.exr,
+                                       false,       {},          args.denoise, args.simd_target};
   // Rank 0 denoises the gathered film with its own threads.
   const Executor denoiser(prepared.sched.strategy, prepared.sched.threads);
-  const driver::DriveResult driven = driver::drive_render(
+  const frontend::DriveResult driven = frontend::drive_render(
       prepared.scene, prepared.camera, prepared.settings, frames,
       // Adaptive sampling decides between passes, from rank 0's image: a round per pass.
       {.holds_image = session.root(),
@@ -102,11 +102,11 @@ int main(int argc, char** argv) {
   }
   CLI::App app{"tracer-mpi: tracer render over the ranks of an Open MPI job (mpirun -np N tracer-mpi render ...)"};
   app.require_subcommand(1);
-  driver::RenderArgs args;
+  frontend::RenderArgs args;
   CLI::App* render = app.add_subcommand("render", "render a scene to a PNG, PPM or OpenEXR image, on every rank");
-  driver::add_render_options(*render, args);
-  driver::add_output_options(*render, args, " (written by rank 0)",
-                             "timings, ray counts and each rank's tiles, rays and idle time");
+  frontend::add_render_options(*render, args);
+  frontend::add_output_options(*render, args, " (written by rank 0)",
+                               "timings, ray counts and each rank's tiles, rays and idle time");
   double rank_timeout = mpi::StallWatch{}.floor_seconds;
   render
       ->add_option("--rank-timeout", rank_timeout,

@@ -10,8 +10,8 @@
 #include <string>
 #include <thread>
 
-#include "driver/render_stats.hpp"
-#include "driver/signals.hpp"
+#include "frontend/render_stats.hpp"
+#include "frontend/signals.hpp"
 #include "mpi/setup_agreement.hpp"
 #include "parallel/parallel_pull.hpp"
 #include "render/render_image.hpp"
@@ -43,8 +43,9 @@ std::string rank_list(const std::vector<int>& list) {
 
 }  // namespace
 
-RankRender::RankRender(const driver::PreparedRender& setup, const driver::RenderArgs& args, const MpiSession& session,
-                       std::vector<uint64_t> threads, double rank_timeout, PhaseWatch& watch_phase)
+RankRender::RankRender(const frontend::PreparedRender& setup, const frontend::RenderArgs& args,
+                       const MpiSession& session, std::vector<uint64_t> threads, double rank_timeout,
+                       PhaseWatch& watch_phase)
     : setup_(setup),
       args_(args),
       session_(session),
@@ -57,7 +58,7 @@ RankRender::RankRender(const driver::PreparedRender& setup, const driver::Render
       tiles_per_rank_(size_t(session.size()), 0) {
   watch_.floor_seconds = rank_timeout;
   if (session.root()) {
-    progress_.emplace(!args.quiet, driver::pixel_samples(setup.settings, args.frames), pixels_done_, rays_done_);
+    progress_.emplace(!args.quiet, frontend::pixel_samples(setup.settings, args.frames), pixels_done_, rays_done_);
   }
 }
 
@@ -191,7 +192,7 @@ void RankRender::report_late_ranks() {
     say("tracer-mpi: error: rank " + rank_list(watch_.gone) + " of " + std::to_string(session_.size()) +
         " stopped answering (no tile back within " + std::to_string(int(watch_.overdue_after())) +
         " s); the other ranks rendered its tiles and the image was written; ending the job");
-    driver::install_immediate_stop_handlers(nullptr);  // the runtime's SIGTERM needs no second message
+    frontend::install_immediate_stop_handlers(nullptr);  // the runtime's SIGTERM needs no second message
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
 }
@@ -219,8 +220,8 @@ void RankRender::report_ranks(int checkpoints) {
   watch_phase_.disarm();
   if (!session_.root()) return;
   const RenderSettings& settings = setup_.settings;
-  nlohmann::json stats =
-      driver::render_stats(setup_.scene, settings, setup_.accel, setup_.sched, args_, setup_.load_ms, render_ms, total);
+  nlohmann::json stats = frontend::render_stats(setup_.scene, settings, setup_.accel, setup_.sched, args_,
+                                                setup_.load_ms, render_ms, total);
   uint64_t all_rays = 0;
   nlohmann::json ranks = nlohmann::json::array();
   for (int r = 0; r < session_.size(); ++r) {
@@ -243,7 +244,7 @@ void RankRender::report_ranks(int checkpoints) {
   stats["rank0_messages"] = served_;
   stats["rank0_us_per_message"] = served_ > 0 ? server_ms_ * 1e3 / double(served_) : 0.0;
   if (args_.stats) {
-    driver::print_stats(stats, setup_.accel);
+    frontend::print_stats(stats, setup_.accel);
     std::printf("rank 0       %.1f ms on %llu messages (%.1f us each)\n", server_ms_, (unsigned long long)served_,
                 served_ > 0 ? server_ms_ * 1e3 / double(served_) : 0.0);
     for (const auto& r : ranks) {
@@ -252,7 +253,7 @@ void RankRender::report_ranks(int checkpoints) {
                   (unsigned long long)r["rays"].get<uint64_t>(), r["idle_ms"].get<double>());
     }
   }
-  driver::write_stats_json(args_.stats_json, stats);
+  frontend::write_stats_json(args_.stats_json, stats);
 }
 
 }  // namespace tracer::mpi

@@ -11,8 +11,8 @@
 
 #include "base/stopwatch.hpp"
 
-#include "driver/prepare_render.hpp"
-#include "driver/progress.hpp"
+#include "frontend/prepare_render.hpp"
+#include "frontend/progress.hpp"
 #include "mpi/mpi_session.hpp"
 #include "mpi/phase_watch.hpp"
 #include "mpi/tile_server.hpp"
@@ -22,10 +22,10 @@ namespace tracer::mpi {
 class RankRender {
  public:
   // `threads`: every rank's render threads (agree_on_setup); `rank_timeout`: --rank-timeout.
-  RankRender(const driver::PreparedRender& setup, const driver::RenderArgs& args, const MpiSession& session,
+  RankRender(const frontend::PreparedRender& setup, const frontend::RenderArgs& args, const MpiSession& session,
              std::vector<uint64_t> threads, double rank_timeout, PhaseWatch& watch_phase);
 
-  // One round of tile distribution of the frame `ctx` (driver::rounds_of): with --checkpoint one
+  // One round of tile distribution of the frame `ctx` (frontend::rounds_of): with --checkpoint one
   // pass, else every pass, each tile rendered whole and sent back once.
   bool render_round(const PassContext& ctx, const std::vector<SampleRange>& round);
   // Rank 0, after the last frame: names the ranks that were late, and ends the job (the image
@@ -44,8 +44,8 @@ class RankRender {
   // late rank (overdue_after()) and the rendering of that rank's tiles.
   double answer_bound() const;
 
-  const driver::PreparedRender& setup_;
-  const driver::RenderArgs& args_;
+  const frontend::PreparedRender& setup_;
+  const frontend::RenderArgs& args_;
   const MpiSession& session_;
   const std::vector<uint64_t> threads_;
   const int my_threads_;
@@ -56,9 +56,9 @@ class RankRender {
   Clock::time_point started_;
   AtomicRayCounts counts_;
   std::atomic<uint64_t> pixels_done_{0}, rays_done_{0};
-  std::optional<driver::ProgressBar> progress_;  // rank 0's, reading the two above
-  std::atomic<double> slowest_tile_s_{0.0};      // this rank's slowest tile so far
-  ActivePixels active_;                          // rank 0, adaptive sampling: this pass's pixels
+  std::optional<frontend::ProgressBar> progress_;  // rank 0's, reading the two above
+  std::atomic<double> slowest_tile_s_{0.0};        // this rank's slowest tile so far
+  ActivePixels active_;                            // rank 0, adaptive sampling: this pass's pixels
   std::mutex idle_mutex_;
   double idle_ms_ = 0;                    // this rank's threads waiting for tiles
   double server_ms_ = 0;                  // rank 0: time spent on messages (requests, returned tiles, done)

@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "base/errors.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/settings_table.hpp"
 #include "parallel/thread_count.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene_checksum.hpp"
@@ -31,7 +31,7 @@ std::pair<std::string, std::string> first_difference(const std::string& ours, co
 
 }  // namespace
 
-std::string settings_fingerprint(const driver::PreparedRender& s, const driver::RenderArgs& args) {
+std::string settings_fingerprint(const frontend::PreparedRender& s, const frontend::RenderArgs& args) {
   // Every flag that defines the image or cuts the work, as given; then what they resolve to on
   // this rank (a views file or a glTF camera may differ between nodes).
   std::ostringstream f;
@@ -43,18 +43,18 @@ std::string settings_fingerprint(const driver::PreparedRender& s, const driver::
     return o.str();
   };
   const RenderSettings& r = s.settings;
-  f << driver::settings_lines(args, {driver::Role::Image, driver::Role::Work}) << "camera " << vec(s.camera.eye) << " "
-    << vec(s.camera.look) << " " << vec(s.camera.up) << " " << s.camera.fov_degrees << " " << s.camera.lens_radius
-    << " " << Camera(s.camera, r.width, r.height).focus_distance() << "\nenvironment " << vec(r.environment)
-    << "\nsamples " << r.spp << " noise threshold " << r.noise_threshold << "\n";
+  f << frontend::settings_lines(args, {frontend::Role::Image, frontend::Role::Work}) << "camera " << vec(s.camera.eye)
+    << " " << vec(s.camera.look) << " " << vec(s.camera.up) << " " << s.camera.fov_degrees << " "
+    << s.camera.lens_radius << " " << Camera(s.camera, r.width, r.height).focus_distance() << "\nenvironment "
+    << vec(r.environment) << "\nsamples " << r.spp << " noise threshold " << r.noise_threshold << "\n";
   return f.str();
 }
 
-void set_up(RankSetup& s, const driver::RenderArgs& args, const MpiSession& session) {
+void set_up(RankSetup& s, const frontend::RenderArgs& args, const MpiSession& session) {
   try {
     if (!args.aov.empty()) throw UsageError("--aov: not for tracer-mpi yet (tracer render writes the layers)");
     s.prepared.emplace(
-        args, driver::PrepareOptions{
+        args, frontend::PrepareOptions{
                   .writes_outputs = session.root(), .quiet = args.quiet || !session.root(), .cancel = nullptr});
     const std::string& note = s.prepared->lighting_note;
     if (!note.empty() && !args.quiet && session.root()) say("tracer-mpi: note: " + note);
@@ -79,7 +79,7 @@ void set_up(RankSetup& s, const driver::RenderArgs& args, const MpiSession& sess
   }
 }
 
-Agreement agree_on_setup(const RankSetup& setup, const driver::RenderArgs& args, const MpiSession& session) {
+Agreement agree_on_setup(const RankSetup& setup, const frontend::RenderArgs& args, const MpiSession& session) {
   // Every rank's readiness and scene checksum, judged on rank 0, which says what is wrong once.
   const std::vector<std::string> errors =
       session.gather_strings(setup.error.empty() ? "" : std::to_string(setup.exit_code) + " " + setup.error);

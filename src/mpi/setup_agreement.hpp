@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "driver/prepare_render.hpp"
+#include "frontend/prepare_render.hpp"
 #include "mpi/mpi_session.hpp"
 
 namespace tracer::mpi {
@@ -18,7 +18,7 @@ void say(const std::string& line);
 
 // This rank's setup. `error` is empty when it is ready; else exit_code says why (1 input, 2 usage).
 struct RankSetup {
-  std::optional<driver::PreparedRender> prepared;
+  std::optional<frontend::PreparedRender> prepared;
   int exit_code = 0;
   std::string error;
   std::string fingerprint;  // settings_fingerprint(), once ready
@@ -26,11 +26,11 @@ struct RankSetup {
 
 // Prepares this rank's render into `setup`, catching what goes wrong: every rank must still join
 // the agreement, so rank 0 can name the rank and end the job instead of waiting for it.
-void set_up(RankSetup& setup, const driver::RenderArgs& args, const MpiSession& session);
+void set_up(RankSetup& setup, const frontend::RenderArgs& args, const MpiSession& session);
 
 // Every setting that changes a pixel or the tiles, one "flag value" line each, in a fixed order:
 // ranks must agree on all of them (the scene itself is checksummed apart).
-std::string settings_fingerprint(const driver::PreparedRender& prepared, const driver::RenderArgs& args);
+std::string settings_fingerprint(const frontend::PreparedRender& prepared, const frontend::RenderArgs& args);
 
 struct Agreement {
   int verdict = 0;                // 0: every rank is ready and alike; else the job's exit code
@@ -39,6 +39,6 @@ struct Agreement {
 
 // Collective: every rank's readiness, scene and environment checksums, threads and settings,
 // judged on rank 0 (which says what is wrong, once), the verdict broadcast to all.
-Agreement agree_on_setup(const RankSetup& setup, const driver::RenderArgs& args, const MpiSession& session);
+Agreement agree_on_setup(const RankSetup& setup, const frontend::RenderArgs& args, const MpiSession& session);
 
 }  // namespace tracer::mpi

@@ -8,16 +8,16 @@
 #include <thread>
 
 #include "base/errors.hpp"
-#include "driver/parse.hpp"
-#include "driver/prepare_render.hpp"
-#include "driver/signals.hpp"
+#include "frontend/parse.hpp"
+#include "frontend/prepare_render.hpp"
+#include "frontend/signals.hpp"
 #include "view/view_server.hpp"
 #include "view/view_session.hpp"
 
 namespace tracer::view {
 
 int run_view(ViewArgs args) {
-  using namespace driver;
+  using namespace frontend;
   std::signal(SIGPIPE, SIG_IGN);  // a closed tab is a failed write, not the end of the process
   const CancelFlag cancel = &stop_requested();
   RenderArgs& r = args.render;

@@ -4,12 +4,12 @@
 
 #include <string>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 
 namespace tracer::view {
 
 struct ViewArgs {
-  driver::RenderArgs render;
+  frontend::RenderArgs render;
   std::string listen = "127.0.0.1";
   int port = 8421;
   bool width_given = false, height_given = false;

@@ -8,9 +8,9 @@
 
 #include "base/errors.hpp"
 #include "denoise/nfor.hpp"
-#include "driver/render_options.hpp"
-#include "driver/scene_setup.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/scene_setup.hpp"
+#include "frontend/settings_table.hpp"
 #include "io/image_io.hpp"
 #include "render/render_image.hpp"
 
@@ -37,33 +37,36 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 // Whether a state's image is denoised: the toggle on (for path tracing) and the image within
 // kMaxDenoisedPixels, whose denoiser planes take 2.8 GB (docs/VIEW.md).
 constexpr int64_t kMaxDenoisedPixels = 2048 * 2048;
-bool denoised(const driver::RenderArgs& a) {
+bool denoised(const frontend::RenderArgs& a) {
   return a.denoise && int64_t(a.settings.width) * int64_t(a.settings.height) <= kMaxDenoisedPixels;
 }
 
 }  // namespace
 
-ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args)
+ViewSession::ViewSession(const Scene& scene, const Accelerator& accel, const frontend::RenderArgs& args)
     : scene_(scene),
       accel_(accel),
-      sched_(driver::sched_options_for(args)),
+      sched_(frontend::sched_options_for(args)),
       args_(args),
       launched_(args),
       denoiser_(sched_.strategy, sched_.threads) {
   args_.denoise = denoise_ && args_.integrator == Integrator::Path;
   // Every state flag explicit, so the copied command says exactly what is shown; the job's camera
   // and settings are then derived from those explicit flags, as the command's will be.
-  const CameraSpec camera = driver::camera_for(scene_, args_);
+  const CameraSpec camera = frontend::camera_for(scene_, args_);
   args_.eye = camera.eye;
   args_.look = camera.look;
   args_.up = camera.up;
   args_.fov = camera.fov_degrees;
   std::string note;
-  const RenderSettings settings = driver::settings_for(args_, scene_, note);
+  const RenderSettings settings = frontend::settings_for(args_, scene_, note);
   args_.spp = settings.spp;
-  job_ = {
-      generation_,    driver::camera_for(scene_, args_), driver::settings_for(args_, scene_, note), false, generation_,
-      denoised(args_)};
+  job_ = {generation_,
+          frontend::camera_for(scene_, args_),
+          frontend::settings_for(args_, scene_, note),
+          false,
+          generation_,
+          denoised(args_)};
   exposure_ = settings.exposure;
 }
 
@@ -92,7 +95,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     const std::lock_guard lock(mu_);
     StateFields fields{args_, denoise_, std::nullopt};
     read_change(change, fields, launched_);
-    driver::RenderArgs& a = fields.args;
+    frontend::RenderArgs& a = fields.args;
     const bool denoise = fields.denoise;
     const std::optional<Vec2>& focus_at = fields.focus_at;
     // The toggle is path tracing's: another integrator renders without it, and a switch back
@@ -100,7 +103,7 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
     a.denoise = denoise && a.integrator == Integrator::Path;
     // The same checks and the same derivation as `tracer render`'s (camera_for rejects a camera
     // looking at its own position or along its up vector).
-    driver::validate(a);
+    frontend::validate(a);
     std::string note;
     if (focus_at) {
       if (const std::optional<float> d = focus_distance_at(a, *focus_at)) {
@@ -109,15 +112,15 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
         note = "nothing there to focus on: the focus stays";
       }
     }
-    const CameraSpec camera = driver::camera_for(scene_, a);
+    const CameraSpec camera = frontend::camera_for(scene_, a);
     std::string settings_note;
-    const RenderSettings settings = driver::settings_for(a, scene_, settings_note);
+    const RenderSettings settings = frontend::settings_for(a, scene_, settings_note);
     exposure_changed = settings.exposure != job_.settings.exposure;
     exposure = settings.exposure;
     // The image's flags but the samples and the exposure (a film goes on with more samples; the
     // exposure tone-maps it) unchanged; adaptive sampling measures noise at the exposure, though,
     // so another one stops other pixels.
-    const bool same_view = driver::same_settings(a, args_, {driver::Role::Image}, {"--spp", "--exposure"}) &&
+    const bool same_view = frontend::same_settings(a, args_, {frontend::Role::Image}, {"--spp", "--exposure"}) &&
                            (!adaptive(settings) || settings.exposure == job_.settings.exposure);
     const bool restart = !same_view || a.spp != args_.spp;
     const bool raised = same_view && *a.spp > *args_.spp;
@@ -148,13 +151,13 @@ nlohmann::json ViewSession::apply(const nlohmann::json& change) {
   return result;
 }
 
-std::optional<float> ViewSession::focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const {
+std::optional<float> ViewSession::focus_distance_at(const frontend::RenderArgs& a, Vec2 pixel) const {
   const int w = a.settings.width, h = a.settings.height;
   if (!(pixel.x >= 0.0f && pixel.x <= float(w) && pixel.y >= 0.0f && pixel.y <= float(h))) {
     throw UsageError("focus_at: " + std::to_string(pixel.x) + "," + std::to_string(pixel.y) + " lies outside the " +
                      std::to_string(w) + "x" + std::to_string(h) + " image");
   }
-  const Camera camera(driver::camera_for(scene_, a), w, h);
+  const Camera camera(frontend::camera_for(scene_, a), w, h);
   Ray ray = camera.ray_through(pixel.x, pixel.y);
   Hit hit;
   const bool found = accel_.visit([&](const auto& accel) { return accel.intersect(ray, hit); });
@@ -180,7 +183,7 @@ nlohmann::json ViewSession::state_locked() const {
   state["generation"] = generation_;
   state["denoise"] = denoise_;
   state["max_side"] = kMaxViewSide;
-  state["command"] = driver::render_command(args_);
+  state["command"] = frontend::render_command(args_);
   state["scene"] = scene_.source;
   state["triangles"] = scene_.size();
   state["scene_size"] = length(scene_.bounds.extent());

@@ -20,9 +20,9 @@
 #include <thread>
 #include <vector>
 
-#include "driver/render_args.hpp"
 #include "film/feature_film.hpp"
 #include "film/tone_map.hpp"
+#include "frontend/render_args.hpp"
 #include "parallel/executor.hpp"
 #include "view/frame_store.hpp"
 #include "view/view_state.hpp"
@@ -33,7 +33,7 @@ class ViewSession {
  public:
   // `args`: the view command's flags (the state starts from them; the copied command says what
   // differs from a default render). The scene and accelerator must outlive the session.
-  ViewSession(const Scene& scene, const Accelerator& accel, const driver::RenderArgs& args);
+  ViewSession(const Scene& scene, const Accelerator& accel, const frontend::RenderArgs& args);
   ~ViewSession();
   ViewSession(const ViewSession&) = delete;
   ViewSession& operator=(const ViewSession&) = delete;
@@ -93,16 +93,16 @@ class ViewSession {
   const Scene& scene_;
   // The distance along the view of the surface seen at image position `pixel` (a click that
   // sets the focus): nothing where the ray leaves the scene; UsageError off the image.
-  std::optional<float> focus_distance_at(const driver::RenderArgs& a, Vec2 pixel) const;
+  std::optional<float> focus_distance_at(const frontend::RenderArgs& a, Vec2 pixel) const;
   const Accelerator& accel_;
   const SchedOptions sched_;
 
   // The state, guarded by mu_; a change bumps generation_ and sets interrupt_ under it.
   mutable std::mutex mu_;
   std::condition_variable cv_;
-  driver::RenderArgs args_;
+  frontend::RenderArgs args_;
   // The flags as launched: a switch of integrator takes those of the new one from here.
-  const driver::RenderArgs launched_;
+  const frontend::RenderArgs launched_;
   bool denoise_ = true;  // the page's toggle; applies to path tracing only
   Job job_;
   uint64_t generation_ = 1;

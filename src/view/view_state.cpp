@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "base/errors.hpp"
-#include "driver/parse.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/parse.hpp"
+#include "frontend/settings_table.hpp"
 
 namespace tracer::view {
 
@@ -23,7 +23,7 @@ Vec2 vec2_field(const std::string& key, const nlohmann::json& value) {
 
 nlohmann::json vec_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
-void read_change(const nlohmann::json& change, StateFields& s, const driver::RenderArgs& launched) {
+void read_change(const nlohmann::json& change, StateFields& s, const frontend::RenderArgs& launched) {
   if (!change.is_object()) throw UsageError("expected a JSON object of fields to change, got " + change.dump());
   const Integrator integrator = s.args.integrator;
   for (const auto& [key, value] : change.items()) {
@@ -36,9 +36,9 @@ void read_change(const nlohmann::json& change, StateFields& s, const driver::Ren
       s.denoise = value.get<bool>();
       continue;
     }
-    const driver::Setting* row = nullptr;
+    const frontend::Setting* row = nullptr;
     std::string keys;
-    for (const driver::Setting& r : driver::settings_table()) {
+    for (const frontend::Setting& r : frontend::settings_table()) {
       if (r.key.empty()) continue;
       if (r.key == key) row = &r;
       keys += r.key + ", ";
@@ -49,14 +49,14 @@ void read_change(const nlohmann::json& change, StateFields& s, const driver::Ren
   }
   for (const char* side : {"width", "height"}) {
     const int v = side[0] == 'w' ? s.args.settings.width : s.args.settings.height;
-    driver::check_range(side, v, 1, kMaxViewSide);
+    frontend::check_range(side, v, 1, kMaxViewSide);
   }
-  if (s.args.integrator != integrator) driver::follow_integrator(s.args, launched);
+  if (s.args.integrator != integrator) frontend::follow_integrator(s.args, launched);
 }
 
-nlohmann::json state_fields(const driver::RenderArgs& args) {
+nlohmann::json state_fields(const frontend::RenderArgs& args) {
   nlohmann::json out = nlohmann::json::object();
-  for (const driver::Setting& r : driver::settings_table()) {
+  for (const frontend::Setting& r : frontend::settings_table()) {
     if (!r.key.empty()) out[r.key] = r.json(args);
   }
   return out;

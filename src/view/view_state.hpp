@@ -1,5 +1,5 @@
 // The viewer's state as its page reads and writes it: the fields are the settings table's rows
-// that have a viewer key (driver/settings_table.hpp), read and checked as the command line's are,
+// that have a viewer key (frontend/settings_table.hpp), read and checked as the command line's are,
 // plus the page's own (its denoise toggle, a pixel to focus at).
 #pragma once
 
@@ -7,7 +7,7 @@
 
 #include <optional>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 #include "math/vec.hpp"
 
 namespace tracer::view {
@@ -19,7 +19,7 @@ inline constexpr int kMaxViewSide = 4096;
 
 // What a change sets: the render flags, the page's denoise toggle, and a pixel to focus at.
 struct StateFields {
-  driver::RenderArgs args;
+  frontend::RenderArgs args;
   bool denoise = true;
   std::optional<Vec2> focus_at;
 };
@@ -28,10 +28,10 @@ struct StateFields {
 // each checked as its flag is. A switch of integrator drops the flags that do not apply to the new
 // one and takes those that do as launched (`launched`: the command's own). Throws UsageError
 // naming the field for an unknown field, a wrong type or a value out of range.
-void read_change(const nlohmann::json& change, StateFields& fields, const driver::RenderArgs& launched);
+void read_change(const nlohmann::json& change, StateFields& fields, const frontend::RenderArgs& launched);
 
 // The table's viewer fields of `args`, as read_change() takes them (an unset one is null).
-nlohmann::json state_fields(const driver::RenderArgs& args);
+nlohmann::json state_fields(const frontend::RenderArgs& args);
 
 nlohmann::json vec_json(Vec3 v);
 

@@ -1,4 +1,4 @@
-#include "driver/render_stats.hpp"
+#include "frontend/render_stats.hpp"
 
 #include <sys/resource.h>
 
@@ -8,7 +8,7 @@
 #include "base/text.hpp"
 #include "io/image_io.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 namespace {
 
@@ -170,4 +170,4 @@ void write_stats_json(const std::string& path, const nlohmann::json& j) {
   }
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -3,11 +3,11 @@
 
 #include <cstdint>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 #include "scene/scene.hpp"
 #include "scene/scene_info.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // What a load may take in memory (LoadLimits::max_memory): `bytes` (0: memory_limit(args)) for the
 // scene and, for each triangle, `accel_bytes_per_triangle` for the accelerator built over it.
@@ -25,4 +25,4 @@ Scene load_scene(const SceneArgs& args, bool quiet, CancelFlag cancel = nullptr,
 SceneInfo scene_info(const SceneArgs& args, bool quiet);
 CameraSpec camera_for(const Scene& scene, const RenderArgs& args);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,12 +1,12 @@
-#include "driver/memory_estimate.hpp"
+#include "frontend/memory_estimate.hpp"
 
 #include <string>
 
 #include "base/errors.hpp"
 #include "base/memory_limit.hpp"
-#include "driver/render_options.hpp"
+#include "frontend/render_options.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 uint64_t memory_limit(const SceneArgs& args) {
   return args.max_memory_mib ? uint64_t(*args.max_memory_mib) << 20 : default_memory_limit();
@@ -45,4 +45,4 @@ void check_render_fits(const Scene& scene, const AccelOptions& options, const Re
                                   bytes, limit));
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -5,10 +5,10 @@
 
 #include <string>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 #include "parallel/thread_count.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 struct PrepareOptions {
   bool writes_outputs = true;   // this process writes -o and --stats-json (tracer-mpi: rank 0 only)
@@ -34,4 +34,4 @@ struct PreparedRender {
   Accelerator accel;
 };
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,10 +1,10 @@
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 
 #include <CLI/CLI.hpp>
 
-#include "driver/settings_table.hpp"
+#include "frontend/settings_table.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 CLI::Option* file_option(CLI::Option* option) {
   return option->check(CLI::Validator(
@@ -27,4 +27,4 @@ void add_render_options(CLI::App& app, RenderArgs& a) {
 
 void validate(const RenderArgs& a) { check_settings(a); }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,4 +1,4 @@
-#include "driver/signals.hpp"
+#include "frontend/signals.hpp"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 
 #include "io/image_io.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 namespace {
 
 std::atomic<bool> g_stop{false};
@@ -68,4 +68,4 @@ const char* stop_signal_name() {
   }
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -4,9 +4,9 @@
 
 #include <string>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // Two paths name the same file: the same inode if both exist, else the same absolute path.
 bool same_file(const std::string& a, const std::string& b);
@@ -18,4 +18,4 @@ void check_outputs_against_inputs(const RenderArgs& args);
 // The output of frame `frame`: `output` itself for a single frame, else NAME-0007.EXT (more digits past 10,000 frames).
 std::string frame_output(const std::string& output, int frame, int frames);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -16,7 +16,7 @@
 #include "render/render_image.hpp"
 #include "scene/scene.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // The --aov layers: first-hit albedo and shading normal; each pixel's sample count (where
 // adaptive sampling stopped); with --denoise, the image before denoising and the variance of
@@ -70,4 +70,4 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
 // The rounds of passes of a frame (sample_passes, grouped as drive_render says).
 std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool round_per_pass);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

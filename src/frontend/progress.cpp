@@ -1,10 +1,10 @@
-#include "driver/progress.hpp"
+#include "frontend/progress.hpp"
 
 #include <unistd.h>
 
 #include <cstdio>
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 ProgressBar::ProgressBar(bool enabled, uint64_t total_pixels, const std::atomic<uint64_t>& pixels,
                          const std::atomic<uint64_t>& rays, const std::atomic<uint64_t>* active, uint64_t image_pixels)
@@ -51,4 +51,4 @@ void ProgressBar::run() {
   if (drawn_) std::fprintf(stderr, "\r%105s\r", "");  // clear the line
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

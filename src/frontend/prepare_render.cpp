@@ -1,12 +1,12 @@
-#include "driver/prepare_render.hpp"
+#include "frontend/prepare_render.hpp"
 
 #include "base/stopwatch.hpp"
-#include "driver/memory_estimate.hpp"
-#include "driver/output_checks.hpp"
-#include "driver/render_options.hpp"
-#include "driver/scene_setup.hpp"
+#include "frontend/memory_estimate.hpp"
+#include "frontend/output_checks.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/scene_setup.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 PreparedRender::PreparedRender(const RenderArgs& args, const PrepareOptions& options) {
   validate(args);
@@ -35,4 +35,4 @@ PreparedRender::PreparedRender(const RenderArgs& args, const PrepareOptions& opt
   accel = build_accelerator(scene, accel_options);
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,4 +1,4 @@
-#include "driver/parse.hpp"
+#include "frontend/parse.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include "base/errors.hpp"
 #include "base/whole_number.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text) {
   double v[3];
@@ -86,4 +86,4 @@ void check_range_real(const std::string& flag, double value, double lo, double h
   }
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

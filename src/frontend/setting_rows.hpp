@@ -16,11 +16,11 @@
 
 #include "base/errors.hpp"
 #include "base/whole_number.hpp"
-#include "driver/parse.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/parse.hpp"
+#include "frontend/settings_table.hpp"
 #include "scene/value_limits.hpp"
 
-namespace tracer::driver::setting_rows {
+namespace tracer::frontend::setting_rows {
 
 using json = nlohmann::json;
 
@@ -261,4 +261,4 @@ inline constexpr IntegratorSet kPath{Integrator::Path};
 inline constexpr IntegratorSet kLit{Integrator::Path, Integrator::Whitted};  // light from beyond the scene
 inline constexpr IntegratorSet kAo{Integrator::Ao};
 
-}  // namespace tracer::driver::setting_rows
+}  // namespace tracer::frontend::setting_rows

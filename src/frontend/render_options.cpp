@@ -1,10 +1,10 @@
-#include "driver/render_options.hpp"
+#include "frontend/render_options.hpp"
 
 #include "base/errors.hpp"
-#include "driver/parse.hpp"
+#include "frontend/parse.hpp"
 #include "io/image_io.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 RenderSettings settings_for(const RenderArgs& a) {
   RenderSettings s = a.settings;
@@ -111,4 +111,4 @@ SchedOptions sched_options_for(const RenderArgs& a) {
   return o;
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

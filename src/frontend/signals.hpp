@@ -6,7 +6,7 @@
 
 #include <atomic>
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // The flag handlers. main() installs them first of all, so that a signal is never lost while
 // the process starts: a shell without job control starts a background job with SIGINT ignored,
@@ -24,4 +24,4 @@ int stop_signal();               // the first signal received, 0 if none
 int exit_code_for_stop();        // 128 + stop_signal()
 const char* stop_signal_name();  // "interrupted", "terminated", "hung up"
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

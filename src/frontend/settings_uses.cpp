@@ -6,10 +6,10 @@
 #include <sstream>
 
 #include "base/errors.hpp"
-#include "driver/render_options.hpp"
-#include "driver/settings_table.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/settings_table.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 std::string IntegratorSet::names(std::string_view separator) const {
   std::string out;
@@ -156,4 +156,4 @@ std::string settings_lines(const RenderArgs& a, std::initializer_list<Role> role
   return out;
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,13 +1,13 @@
-#include "driver/settings_table.hpp"
+#include "frontend/settings_table.hpp"
 
 #include <sstream>
 #include <stdexcept>
 
-#include "driver/render_options.hpp"
-#include "driver/setting_rows.hpp"
+#include "frontend/render_options.hpp"
+#include "frontend/setting_rows.hpp"
 #include "scene/camera.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 namespace {
 
@@ -310,4 +310,4 @@ const Setting& setting(std::string_view flag) {
   throw std::logic_error("no setting " + std::string(flag));
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

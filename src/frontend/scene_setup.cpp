@@ -1,4 +1,4 @@
-#include "driver/scene_setup.hpp"
+#include "frontend/scene_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 
 #include "base/errors.hpp"
 #include "base/text.hpp"
-#include "driver/memory_estimate.hpp"
-#include "driver/output_checks.hpp"
-#include "driver/parse.hpp"
+#include "frontend/memory_estimate.hpp"
+#include "frontend/output_checks.hpp"
+#include "frontend/parse.hpp"
 #include "importers/gltf_loader.hpp"
 #include "importers/scene_file.hpp"
 #include "io/environment_io.hpp"
@@ -18,7 +18,7 @@
 #include "scene/camera.hpp"
 #include "scene/views.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 namespace {
 
@@ -185,4 +185,4 @@ SceneInfo scene_info(const SceneArgs& a, bool quiet) {
   return gltf_info(a.scene, quiet ? silent : WarningSink{}, nullptr, limits);
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -1,4 +1,4 @@
-#include "driver/output_checks.hpp"
+#include "frontend/output_checks.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include "base/errors.hpp"
 #include "io/image_io.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 namespace fs = std::filesystem;
 
@@ -46,4 +46,4 @@ std::string frame_output(const std::string& output, int frame, int frames) {
   return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -7,10 +7,10 @@
 #include <cstdint>
 
 #include "accel/accelerator.hpp"
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 #include "scene/scene.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // Per pixel, measured as the peak resident set of `tracer render --spp 1` at 4096 x 4096 less
 // that at 64 x 64 (docs/RELIABILITY.md, "Memory"), rounded up: the film's sums and counts with
@@ -34,4 +34,4 @@ void check_film_fits(const RenderArgs& args, uint64_t limit);
 // film are above `limit`.
 void check_render_fits(const Scene& scene, const AccelOptions& options, const RenderArgs& args, uint64_t limit);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

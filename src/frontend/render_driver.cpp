@@ -1,15 +1,15 @@
-#include "driver/render_driver.hpp"
+#include "frontend/render_driver.hpp"
 
 #include <chrono>
 
 #include "denoise/nfor.hpp"
-#include "driver/output_checks.hpp"
-#include "driver/render_args.hpp"
-#include "driver/render_options.hpp"
+#include "frontend/output_checks.hpp"
+#include "frontend/render_args.hpp"
+#include "frontend/render_options.hpp"
 #include "io/image_io.hpp"
 #include "scene/camera.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 std::vector<std::vector<SampleRange>> rounds_of(const RenderSettings& settings, bool round_per_pass) {
   const std::vector<SampleRange> passes = sample_passes(settings);
@@ -130,4 +130,4 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
   return result;
 }
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
-#include "driver/render_driver.hpp"
+#include "frontend/render_driver.hpp"
 #include "importers/load_limits.hpp"
 #include "io/exr_io.hpp"
 #include "math/vec.hpp"
@@ -19,7 +19,7 @@ class Option;
 class App;  // CLI11: only the files that add or parse flags include it (a heavy header)
 }  // namespace CLI
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 struct SceneArgs {
   std::string scene;  // empty: the built-in Cornell box; .obj, .gltf, .glb or .ply
@@ -90,4 +90,4 @@ void add_output_options(CLI::App& app, RenderArgs& args, const std::string& writ
 // Checks every flag; throws UsageError naming the flag. Changes nothing.
 void validate(const RenderArgs& args);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

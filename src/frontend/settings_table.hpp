@@ -15,13 +15,13 @@
 #include <string>
 #include <string_view>
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 
 namespace CLI {
 class App;  // CLI11: only the files that add or parse flags include it (a heavy header)
 }  // namespace CLI
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // The integrators a flag applies to, a bit each.
 class IntegratorSet {
@@ -107,4 +107,4 @@ bool same_settings(const RenderArgs& a, const RenderArgs& b, std::initializer_li
 // Quotes a word for a POSIX shell when it needs it.
 std::string shell_quote(const std::string& word);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

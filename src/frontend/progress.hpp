@@ -12,7 +12,7 @@
 
 #include "render/render_settings.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 // The pixel samples `frames` images of `settings` take at most: a progress bar's whole (adaptive
 // sampling may end sooner).
@@ -43,4 +43,4 @@ class ProgressBar {
   std::thread thread_;
 };
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -2,10 +2,10 @@
 // output's options.
 #pragma once
 
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 #include "scene/scene.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 RenderSettings settings_for(const RenderArgs& args);
 // The path integrator's samples per pixel when --spp is not given.
@@ -35,4 +35,4 @@ SchedOptions sched_options_for(const RenderArgs& args);
 // --aov: a comma-separated list of albedo, normal and samples, only for path renders to .exr; throws UsageError.
 Aovs aovs_for(const RenderArgs& args);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "accel/accelerator.hpp"
-#include "driver/render_args.hpp"
+#include "frontend/render_args.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, const Accelerator& accel,
                             const SchedOptions& sched, const RenderArgs& args, double load_ms, double render_ms,
@@ -20,4 +20,4 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel);
 // --stats-json: `j` written to `path` (atomically), to standard output for "-", nowhere for "".
 void write_stats_json(const std::string& path, const nlohmann::json& j);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend

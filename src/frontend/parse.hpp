@@ -7,7 +7,7 @@
 
 #include "math/vec.hpp"
 
-namespace tracer::driver {
+namespace tracer::frontend {
 
 Vec3 parse_vec3(const std::string& flag, const std::string& text);
 // "WxH", each 1-16384.
@@ -21,4 +21,4 @@ void check_range(const std::string& flag, long long value, long long lo, long lo
 enum class LowEnd { Closed, Open };
 void check_range_real(const std::string& flag, double value, double lo, double hi, LowEnd low = LowEnd::Closed);
 
-}  // namespace tracer::driver
+}  // namespace tracer::frontend
