@@ -30,7 +30,7 @@ RayCounts render_one(const Accelerator& accel, const PassContext& ctx, const std
   RayCounts counts;
   for (const SampleRange& pass : round) {
     c.samples = pass;
-    counts += accel.visit([&](const auto& a) { return render_tile(a, c, tile); });
+    counts += render_tile_of(accel, c, tile).rays;
   }
   return counts;
 }

@@ -22,47 +22,47 @@ void choose_active_pixels(PassContext& ctx, RenderMonitor& control) {
   ctx.active = &control.active;
 }
 
+TileResult render_tile_of(const Accelerator& accel, const PassContext& ctx, const Tile& tile, CancelFlag cancel) {
+  // The tile is walked in pieces of kPieceWidth x kPacketEdge pixels (aligned to the tile, so
+  // packet blocks are the same) with the cancel flag checked between them: a whole-row tile of
+  // the async and seq schedulers or a --tile 4096 stops within moments of a Ctrl-C.
+  constexpr int kPieceWidth = 64;
+  TileResult result;
+  const auto pieces = [&](const auto& a) {
+    for (int y = tile.y0; y < tile.y1 && !is_cancelled(cancel); y += kPacketEdge) {
+      for (int x = tile.x0; x < tile.x1 && !is_cancelled(cancel); x += kPieceWidth) {
+        const Tile piece{x, y, std::min(x + kPieceWidth, tile.x1), std::min(y + kPacketEdge, tile.y1)};
+        result.rays += render_tile(a, ctx, piece);
+        result.pixels += uint64_t(piece.pixel_count());
+      }
+    }
+  };
+  accel.visit([&](const auto& a) {
+    using A = std::decay_t<decltype(a)>;
+    if constexpr (CountingAccelerator<A>) {
+      if (ctx.settings.count_traversal) {
+        pieces(Counted<A>(a, result.traversal));
+        return;
+      }
+    }
+    pieces(a);
+  });
+  return result;
+}
+
 bool render_image(const Accelerator& accel, const PassContext& image, const SchedOptions& options,
                   RenderMonitor& control) {
   PassContext ctx = image;
   choose_active_pixels(ctx, control);
-  return parallel_for_tiles(
-      ctx.framebuffer->width(), ctx.framebuffer->height(), options, control.cancel, [&](const Tile& tile) {
-        // The accelerator variant is dispatched once per tile (as tracer-mpi's rank_render does
-        // for the tiles it is handed, and the viewer for a click's one ray); the tile is walked in
-        // pieces of kPieceWidth x kPacketEdge pixels (aligned to the tile, so packet blocks are the
-        // same) with the cancel flag checked between them: a whole-row tile of the async and seq
-        // schedulers or a --tile 4096 stops within moments of a Ctrl-C.
-        constexpr int kPieceWidth = 64;
-        const auto pieces = [&](const auto& a) {
-          RayCounts sum;
-          uint64_t pixels = 0;
-          for (int y = tile.y0; y < tile.y1 && !control.cancelled(); y += kPacketEdge) {
-            for (int x = tile.x0; x < tile.x1 && !control.cancelled(); x += kPieceWidth) {
-              const Tile piece{x, y, std::min(x + kPieceWidth, tile.x1), std::min(y + kPacketEdge, tile.y1)};
-              sum += render_tile(a, ctx, piece);
-              pixels += uint64_t(piece.pixel_count());
-            }
-          }
-          control.pixels_done.fetch_add(pixels * ctx.samples.count, std::memory_order_relaxed);
-          return sum;
-        };
-        const RayCounts counts = accel.visit([&](const auto& a) {
-          using A = std::decay_t<decltype(a)>;
-          if constexpr (CountingAccelerator<A>) {
-            if (ctx.settings.count_traversal) {
-              QueryCounts traversal;
-              const RayCounts sum = pieces(Counted<A>(a, traversal));
-              control.traversal.add(traversal);
-              return sum;
-            }
-          }
-          return pieces(a);
-        });
-        control.counts.add(counts);
-        control.rays_done.fetch_add(counts.total(), std::memory_order_relaxed);
-        if (control.on_tile) control.on_tile(tile);
-      });
+  return parallel_for_tiles(ctx.framebuffer->width(), ctx.framebuffer->height(), options, control.cancel,
+                            [&](const Tile& tile) {
+                              const TileResult r = render_tile_of(accel, ctx, tile, control.cancel);
+                              control.pixels_done.fetch_add(r.pixels * ctx.samples.count, std::memory_order_relaxed);
+                              if (ctx.settings.count_traversal) control.traversal.add(r.traversal);
+                              control.counts.add(r.rays);
+                              control.rays_done.fetch_add(r.rays.total(), std::memory_order_relaxed);
+                              if (control.on_tile) control.on_tile(tile);
+                            });
 }
 
 std::vector<SampleRange> sample_passes(const RenderSettings& settings) {

@@ -31,6 +31,19 @@ struct RenderMonitor {
   bool cancelled() const { return is_cancelled(cancel); }
 };
 
+// What one tile's render traced: its rays, the pixels it reached (all of them unless cancelled)
+// and, with settings.count_traversal on an accelerator that counts, what its queries visited.
+struct TileResult {
+  RayCounts rays;
+  uint64_t pixels = 0;
+  QueryCounts traversal;
+};
+// ctx.samples of the pixels of `tile` into ctx's films: the accelerator's variant dispatched once
+// for the tile, which is walked in pieces with `cancel` checked between them. What render_image
+// does for each tile, and tracer-mpi's ranks for each tile they are handed.
+TileResult render_tile_of(const Accelerator& accel, const PassContext& ctx, const Tile& tile,
+                          CancelFlag cancel = nullptr);
+
 // Renders ctx.samples of every pixel into ctx.framebuffer with `accel`. Returns false if
 // cancelled before finishing (tiles not reached are left untouched).
 bool render_image(const Accelerator& accel, const PassContext& ctx, const SchedOptions& options,
