@@ -46,6 +46,7 @@ const T& get(Field<T> field, const RenderArgs& a) {
 // What a value type needs for a row: its text, its range, its JSON.
 template <class V>
 struct Codec {
+  std::string value_name;  // for --help
   std::function<V(const std::string& name, const std::string& text)> parse;
   std::function<std::string(const V&)> format;
   std::function<void(const std::string& name, const V&)> check;  // null: every value parse gives is in range
@@ -70,6 +71,7 @@ inline double json_number(const std::string& name, const json& value) {
 template <class I>
 Codec<I> whole(long long lo, long long hi) {
   Codec<I> c;
+  c.value_name = "INT";
   c.parse = [lo, hi](const std::string& name, const std::string& text) {
     long long v = 0;
     const WholeNumber read = read_whole_number(text, v);
@@ -96,6 +98,7 @@ Codec<I> whole(long long lo, long long hi) {
 template <class F>
 Codec<F> real(double lo, double hi, LowEnd low = LowEnd::Closed) {
   Codec<F> c;
+  c.value_name = "FLOAT";
   c.parse = [](const std::string& name, const std::string& text) {
     double v = 0;
     const WholeNumber read = read_whole_number(text, v);
@@ -113,6 +116,7 @@ Codec<F> real(double lo, double hi, LowEnd low = LowEnd::Closed) {
 template <class E>
 Codec<E> choice(std::span<const EnumName<E>> names, std::string what) {
   Codec<E> c;
+  c.value_name = "NAME";
   c.parse = [names, what](const std::string& name, const std::string& text) {
     return parse_name<E>(names, text, name, what);
   };
@@ -128,6 +132,7 @@ Codec<E> choice(std::span<const EnumName<E>> names, std::string what) {
 enum class VecKind { Point, Direction, Radiance };
 inline Codec<Vec3> vector(VecKind kind) {
   Codec<Vec3> c;
+  c.value_name = "X,Y,Z";
   c.parse = [](const std::string& name, const std::string& text) { return parse_vec3(name, text); };
   c.format = [](const Vec3& v) { return shortest(v.x) + "," + shortest(v.y) + "," + shortest(v.z); };
   c.check = [kind](const std::string& name, const Vec3& v) {
@@ -166,6 +171,7 @@ inline Codec<Vec3> vector(VecKind kind) {
 // A name (a file, a view): any text, or with `nonempty` any but the empty one.
 inline Codec<std::string> name_codec(bool nonempty) {
   Codec<std::string> c;
+  c.value_name = nonempty ? "FILE" : "TEXT";
   c.parse = [nonempty](const std::string& name, const std::string& text) {
     if (nonempty && text.empty()) throw UsageError(name + ": an empty file name");
     return text;
@@ -185,6 +191,7 @@ Setting row(Setting s, Field<T> field, Codec<V> c) {
       return get(field, a);
     }
   };
+  s.value_name = c.value_name;
   s.text = [value, c](const RenderArgs& a) -> std::optional<std::string> {
     const std::optional<V> v = value(a);
     if (!v) return std::nullopt;
@@ -242,6 +249,7 @@ inline Setting tristate(Setting s, Field<std::optional<bool>> field, bool on) {
 inline Setting points(Setting s, Field<std::vector<Vec3>> field) {
   const Codec<Vec3> c = vector(VecKind::Point);
   s.repeatable = true;
+  s.value_name = c.value_name;
   s.text = [field, c](const RenderArgs& a) -> std::optional<std::string> {
     std::string out;
     for (const Vec3& v : get(field, a)) out += (out.empty() ? "" : " ") + c.format(v);

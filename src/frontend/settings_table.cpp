@@ -130,7 +130,7 @@ std::vector<Setting> make_table() {
   t.push_back(row<int>(
       {.names = "--max-depth",
        .key = "max_depth",
-       .help = "whitted: reflections and refractions followed; path: bounces per path",
+       .help = "reflections and refractions followed (whitted), bounces per path (path)",
        .applies = kLit},
       [](RenderArgs & a) -> auto& { return a.settings.max_depth; }, whole<int>(0, 64)));
   t.push_back(row<std::optional<int>>(

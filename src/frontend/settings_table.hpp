@@ -79,6 +79,7 @@ struct Setting {
   bool toggle = false;      // takes no value (--denoise)
   bool repeatable = false;  // given any number of times (--light)
   std::string excludes;     // a flag it may not be given with
+  std::string value_name;   // what --help calls its value: INT, FLOAT, X,Y,Z, FILE, NAME
 };
 
 const std::span<const Setting> settings_table();

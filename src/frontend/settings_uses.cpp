@@ -80,6 +80,7 @@ void add_settings(CLI::App& app, RenderArgs& args, std::initializer_list<Setting
       if (const std::optional<std::string> d = s.text(defaults)) option->default_str(*d);
     }
     if (!s.excludes.empty()) option->excludes(s.excludes);
+    if (!s.value_name.empty()) option->type_name(s.value_name);
   }
 }
 
