@@ -362,7 +362,18 @@ bool ViewSession::render_job(const Job& job) {
     // the pause before the full image).
     if (job.denoise && !denoise_display(job, p + 1 == passes.size())) return false;
   }
-  if (first_pass == passes.size()) publish_display(true);  // the film already holds them all
+  if (first_pass == passes.size()) {
+    // The film already holds them all. A denoised state whose film's denoise a change
+    // interrupted (the spp lowered to a pass boundary during it) denoises it now: the frame
+    // shown so far is the noisy film, not this state's image.
+    bool awaits_denoise = false;
+    {
+      const std::lock_guard lock(display_mu_);
+      awaits_denoise = display_awaits_denoise_;
+    }
+    if (job.denoise && awaits_denoise) return denoise_display(job, true);
+    publish_display(true);
+  }
   return true;
 }
 
