@@ -76,25 +76,42 @@ struct PrimSplitter::SideCentroids {
   }
 };
 
-PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+PrimSplitter::PrimSplitter(const Scene& scene, TriangleRange range, const BvhBuildOptions& options,
+                           const Executor& exec)
     : options_(options), exec_(exec), tris_(scene.triangles.data()) {
+  const Triangle* tris = scene.triangles.data() + range.first;
+  // Degenerate triangles are left out.
+  fill(
+      range.count, [&](uint32_t i) { return !tris[i].degenerate(); },
+      [&](uint32_t i) { return PrimRef::make(tris[i].bounds(), range.first + i); });
+}
+
+PrimSplitter::PrimSplitter(std::span<const Aabb> boxes, const BvhBuildOptions& options, const Executor& exec)
+    : options_(options), exec_(exec), tris_(nullptr) {
+  options_.split_budget = 0.0f;  // a box has no triangle to cut
+  fill(
+      uint32_t(boxes.size()), [&](uint32_t i) { return !boxes[i].empty(); },
+      [&](uint32_t i) { return PrimRef::make(boxes[i], i); });
+}
+
+template <class Keep, class Make>
+void PrimSplitter::fill(uint32_t n, const Keep& keep, const Make& make) {
   options_.bins = std::clamp(options_.bins, 2, kMaxSahBins);
   options_.max_leaf = std::clamp(options_.max_leaf, 1, 255);
   options_.split_budget = std::clamp(options_.split_budget, 0.0f, 4.0f);
-  const auto n = static_cast<uint32_t>(scene.size());
   capacity_ = uint32_t(std::min<uint64_t>(uint64_t(n) + uint64_t(double(n) * options_.split_budget), UINT32_MAX));
   // Left uninitialised: every slot is written before it is read.
   refs_ = LargeBuffer<PrimRef>(capacity_);
   PrimRef* refs = refs_.get();
-  // Degenerate triangles are left out. In parallel: count per block, then fill at the offsets.
-  const auto fill = [&](uint32_t b, uint32_t e, uint32_t out) {
+  // In parallel: count per block, then fill at the offsets.
+  const auto fill_block = [&](uint32_t b, uint32_t e, uint32_t out) {
     for (uint32_t i = b; i < e; ++i) {
-      if (!scene.triangles[i].degenerate()) refs[out++] = PrimRef::make(scene.triangles[i].bounds(), i);
+      if (keep(i)) refs[out++] = make(i);
     }
     return out;
   };
   if (!exec_.data_parallel() || n < kParallelSplit) {
-    count_ = fill(0, n, 0);
+    count_ = fill_block(0, n, 0);
     capacity_ -= n - count_;
     return;
   }
@@ -102,13 +119,12 @@ PrimSplitter::PrimSplitter(const Scene& scene, const BvhBuildOptions& options, c
   std::vector<uint32_t> offsets(blocks + 1, 0);
   exec_.for_each(blocks, [&](size_t k) {
     uint32_t c = 0;
-    for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i)
-      c += scene.triangles[i].degenerate() ? 0 : 1;
+    for (uint32_t i = k * kPartitionBlock, e = std::min(n, i + kPartitionBlock); i < e; ++i) c += keep(i) ? 1 : 0;
     offsets[k + 1] = c;
   });
   for (uint32_t k = 0; k < blocks; ++k) offsets[k + 1] += offsets[k];
   exec_.for_each(blocks, [&](size_t k) {
-    fill(uint32_t(k) * kPartitionBlock, std::min(n, uint32_t(k + 1) * kPartitionBlock), offsets[k]);
+    fill_block(uint32_t(k) * kPartitionBlock, std::min(n, uint32_t(k + 1) * kPartitionBlock), offsets[k]);
   });
   count_ = offsets[blocks];
   capacity_ -= n - count_;

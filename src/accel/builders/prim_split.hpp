@@ -12,6 +12,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <span>
 
 #include <immintrin.h>  // SSE2, part of every x86-64
 
@@ -90,9 +91,14 @@ class PrimSplitter {
   // Ranges this large split their bounds, binning and partition over the executor's threads.
   static constexpr uint32_t kParallelSplit = 65536;
 
-  // Every non-degenerate triangle of `scene`, in scene order (filled in parallel when the
-  // executor is data-parallel).
-  PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
+  // Every non-degenerate triangle of `range` of the scene's, in scene order (filled in parallel
+  // when the executor is data-parallel); a primitive's id is its scene index.
+  PrimSplitter(const Scene& scene, TriangleRange range, const BvhBuildOptions& options, const Executor& exec);
+  PrimSplitter(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+      : PrimSplitter(scene, TriangleRange::all(scene), options, exec) {}
+  // Every non-empty box (a top-level tree's instances); a primitive's id is its index in `boxes`.
+  // No spatial splits: there is no triangle to cut.
+  PrimSplitter(std::span<const Aabb> boxes, const BvhBuildOptions& options, const Executor& exec);
 
   uint32_t count() const { return count_; }
   // Slots for references: count() and the spatial splits' budget.
@@ -112,6 +118,9 @@ class PrimSplitter {
 
  private:
   struct SideCentroids;
+  // Fills refs_ with make(i) for each i in [0, n) that keep(i) admits, in order.
+  template <class Keep, class Make>
+  void fill(uint32_t n, const Keep& keep, const Make& make);
   uint32_t median_split(PrimRef* refs, uint32_t begin, uint32_t end, int axis);
   bool split_spatially(PrimRange& r, const SpatialSplit& s, PrimRange (&out)[2]);
   void share_room(const PrimRange& r, uint32_t mid, PrimRange (&out)[2]);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accel/builders/prim_split.hpp"
+#include "accel/builders/wide_tree_build.hpp"
 #include "accel/wide_bvh/wide_bvh.hpp"
 
 namespace tracer {
@@ -23,16 +24,16 @@ constexpr size_t kPackBlock = 1024;          // packs filled per parallel item
 
 class WideBuilder {
  public:
-  WideBuilder(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
-      : scene_(scene), options_(options), exec_(exec), splitter_(scene, options, exec) {
-    // Every inner node holds more than one pack's primitives and at least two children, and one
-    // with fewer than eight has only packs below it, so n references make fewer than n/2 + 2.
+  WideBuilder(PrimSplitter& splitter, const BvhBuildOptions& options, const Executor& exec, uint32_t leaf_size)
+      : options_(options), exec_(exec), splitter_(splitter), leaf_size_(leaf_size) {
+    // Every inner node holds more than one leaf's primitives and at least two children, and one
+    // with fewer than eight has only leaves below it, so n references make fewer than n/2 + 2.
     // Left uninitialised: only the nodes taken are touched.
     scratch_ = LargeBuffer<WideNode>(splitter_.capacity() / 2 + 2);
   }
 
-  // Builds the tree into `nodes` and `packs`; returns the bounds of everything in it.
-  Aabb build(WideNodeArray& nodes, PackArray& packs) {
+  // Builds the tree into `nodes` and `runs`; returns the bounds of everything in it.
+  Aabb build(WideNodeArray& nodes, std::vector<LeafRun>& runs) {
     if (splitter_.count() == 0) return Aabb{};
     PrimRange root = splitter_.root();
     splitter_.bound(root, parallel_split(root));
@@ -42,15 +43,15 @@ class WideBuilder {
     if (failed_) throw std::logic_error("8-wide BVH build: a node of more than one pack could not be split");
     nodes.clear();
     nodes.reserve(used_);
-    place(0, nodes);
-    fill_packs(packs);
+    runs.clear();
+    place(0, nodes, runs);
     return root.box;
   }
 
  private:
-  // A subtree of at most one pack's worth of triangles becomes one leaf: testing eight lanes
-  // costs about what one more level of boxes would, and saves that level's loads.
-  static bool packable(const PrimRange& r) { return r.size() <= uint32_t(kWideWidth); }
+  // A subtree of at most leaf_size_ primitives becomes one leaf: for triangles, one pack's worth
+  // (testing eight lanes costs about what one more level of boxes would, and saves its loads).
+  bool packable(const PrimRange& r) const { return r.size() <= leaf_size_; }
   bool parallel_split(const PrimRange& r) const {
     return exec_.data_parallel() && r.size() >= PrimSplitter::kParallelSplit;
   }
@@ -139,9 +140,9 @@ class WideBuilder {
     return true;
   }
 
-  // Copies scratch node `s` and its subtree, depth first, to the end of `out`, numbering packs
-  // in the same order; returns its index there.
-  uint32_t place(uint32_t s, WideNodeArray& out) {
+  // Copies scratch node `s` and its subtree, depth first, to the end of `out`, numbering leaf
+  // runs in the same order; returns its index there.
+  uint32_t place(uint32_t s, WideNodeArray& out, std::vector<LeafRun>& runs) {
     const auto self = static_cast<uint32_t>(out.size());
     out.push_back(scratch_[s]);
     for (int i = 0; i < kWideWidth; ++i) {
@@ -149,64 +150,70 @@ class WideBuilder {
       if (count == 0 && child == kInvalidIndex) {
         out[self].child[i] = 0;
       } else if (count != 0) {
-        out[self].child[i] = static_cast<uint32_t>(runs_.size());
-        runs_.push_back({child, count});
+        out[self].child[i] = static_cast<uint32_t>(runs.size());
+        runs.push_back({child, count});
       } else {
-        const uint32_t placed = place(child, out);  // may reallocate out: index, not reference
+        const uint32_t placed = place(child, out, runs);  // may reallocate out: index, not reference
         out[self].child[i] = placed;
       }
     }
     return self;
   }
 
-  // Fills the packs from the primitive runs, in parallel: each gathers its triangles from the
-  // scene, a cache miss per triangle on large scenes.
-  void fill_packs(PackArray& packs) const {
-    packs.resize(runs_.size());
-    const auto fill = [&](size_t begin, size_t end) {
-      for (size_t k = begin; k < end; ++k) {
-        const Run& r = runs_[k];
-        uint32_t ids[kWideWidth];
-        for (uint32_t j = 0; j < r.count; ++j) ids[j] = splitter_.refs()[r.first + j].id();
-        // By triangle: the partitions' order is not the same on every executor. At most eight.
-        for (uint32_t j = 1; j < r.count; ++j) {
-          for (uint32_t m = j; m > 0 && ids[m - 1] > ids[m]; --m) std::swap(ids[m - 1], ids[m]);
-        }
-        packs[k] = make_triangle_pack(scene_.triangles, ids, 0, r.count);
-      }
-    };
-    const auto blocks = uint32_t((runs_.size() + kPackBlock - 1) / kPackBlock);
-    if (!exec_.data_parallel() || blocks < 2) return fill(0, runs_.size());
-    exec_.for_each(blocks, [&](size_t b) { fill(b * kPackBlock, std::min(runs_.size(), (b + 1) * kPackBlock)); });
-  }
-
-  struct Run {
-    uint32_t first, count;
-  };
-
-  const Scene& scene_;
   const BvhBuildOptions& options_;
   const Executor& exec_;
-  PrimSplitter splitter_;
+  PrimSplitter& splitter_;
+  uint32_t leaf_size_;
   LargeBuffer<WideNode> scratch_;
   std::atomic<uint32_t> used_{0};
   std::atomic<bool> failed_{false};
-  std::vector<Run> runs_;  // per pack, in its final order
 };
 
+// Fills the packs from the leaf runs, in parallel: each gathers its triangles from the scene, a
+// cache miss per triangle on large scenes.
+void fill_packs(const Scene& scene, const PrimSplitter& splitter, const std::vector<LeafRun>& runs,
+                const Executor& exec, PackArray& packs) {
+  packs.resize(runs.size());
+  const auto fill = [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const LeafRun& r = runs[k];
+      uint32_t ids[kWideWidth];
+      for (uint32_t j = 0; j < r.count; ++j) ids[j] = splitter.refs()[r.first + j].id();
+      // By triangle: the partitions' order is not the same on every executor. At most eight.
+      for (uint32_t j = 1; j < r.count; ++j) {
+        for (uint32_t m = j; m > 0 && ids[m - 1] > ids[m]; --m) std::swap(ids[m - 1], ids[m]);
+      }
+      packs[k] = make_triangle_pack(scene.triangles, ids, 0, r.count);
+    }
+  };
+  const auto blocks = uint32_t((runs.size() + kPackBlock - 1) / kPackBlock);
+  if (!exec.data_parallel() || blocks < 2) return fill(0, runs.size());
+  exec.for_each(blocks, [&](size_t b) { fill(b * kPackBlock, std::min(runs.size(), (b + 1) * kPackBlock)); });
+}
+
 }  // namespace
+
+Aabb build_wide_tree(PrimSplitter& splitter, const BvhBuildOptions& options, const Executor& exec, uint32_t leaf_size,
+                     WideNodeArray& nodes, std::vector<LeafRun>& runs) {
+  return WideBuilder(splitter, options, exec, leaf_size).build(nodes, runs);
+}
 
 WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options)
     : WideBvh(scene, options, Executor(options.strategy, options.threads)) {}
 
-WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options_in, const Executor& exec)
+WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec)
+    : WideBvh(scene, TriangleRange::all(scene), options, exec) {}
+
+WideBvh::WideBvh(const Scene& scene, TriangleRange range, const BvhBuildOptions& options_in, const Executor& exec)
     : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f), simd_(SimdDispatch::of(options_in.simd)) {
   BvhBuildOptions options = options_in;
   // Nodes of more than one pack are always split, so the SAH never weighs a leaf larger than one.
   options.max_leaf = std::min(options.max_leaf, kWideWidth);
   exec.run([&] {
-    WideBuilder builder(scene, options, exec);
-    bounds_ = builder.build(nodes_, packs_);
+    PrimSplitter splitter(scene, range, options, exec);
+    std::vector<LeafRun> runs;
+    bounds_ = build_wide_tree(splitter, options, exec, kWideWidth, nodes_, runs);
+    fill_packs(scene, splitter, runs, exec, packs_);
   });
 }
 

@@ -37,6 +37,9 @@ class WideBvh {
   // triangles) directly, 8-wide: wide_bvh_build.cpp.
   WideBvh(const Scene& scene, const BvhBuildOptions& options);
   WideBvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
+  // The tree over `range` of the scene's triangles only (a mesh of an instanced scene); its hits
+  // name scene triangles as the whole scene's tree does.
+  WideBvh(const Scene& scene, TriangleRange range, const BvhBuildOptions& options, const Executor& exec);
 
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
