@@ -256,7 +256,7 @@ double emitter_chi_square(const Scene& scene, const Emitters& sampled, const Emi
           const Vec3 w = frame.to_world(Vec3{float(std::sin(theta) * std::cos(phi)),
                                              float(std::sin(theta) * std::sin(phi)), float(std::cos(theta))});
           if (const std::optional<Vec3> p = hit_point(scene.triangles[0], Vec3{0.0f}, w)) {
-            sum += double(judged.pdf(scene, 0, Vec3{0.0f}, *p)) * std::sin(theta);
+            sum += double(judged.pdf(scene, 0, kInvalidIndex, Vec3{0.0f}, *p)) * std::sin(theta);
           }
         }
       }

@@ -69,6 +69,21 @@ struct Affine {
             float(cof[1][0] * n.x + cof[1][1] * n.y + cof[1][2] * n.z),
             float(cof[2][0] * n.x + cof[2][1] * n.y + cof[2][2] * n.z)};
   }
+  // The inverse map (the caller checks the determinant is not zero): the linear part's adjugate
+  // over its determinant, and the translation moved back through it.
+  Affine inverse() const {
+    const auto c = [&](int r0, int c0, int r1, int c1) { return m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]; };
+    const double inv_det = 1.0 / determinant();
+    Affine out;
+    const double adj[3][3] = {{c(1, 1, 2, 2), -c(0, 1, 2, 2), c(0, 1, 1, 2)},
+                              {-c(1, 0, 2, 2), c(0, 0, 2, 2), -c(0, 0, 1, 2)},
+                              {c(1, 0, 2, 1), -c(0, 0, 2, 1), c(0, 0, 1, 1)}};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) out.m[i][j] = adj[i][j] * inv_det;
+      out.m[i][3] = -(out.m[i][0] * m[0][3] + out.m[i][1] * m[1][3] + out.m[i][2] * m[2][3]);
+    }
+    return out;
+  }
   bool finite() const {
     for (const auto& row : m)
       for (double v : row)

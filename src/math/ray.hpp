@@ -27,6 +27,7 @@ struct Hit {
   uint32_t geomID = kInvalidIndex;
   uint32_t primID = kInvalidIndex;
   uint32_t tri = kInvalidIndex;
+  uint32_t inst = kInvalidIndex;  // the instance whose mesh holds `tri` (instanced scenes)
 
   bool valid() const { return tri != kInvalidIndex; }
 };

@@ -23,15 +23,15 @@ struct SurfaceInteraction {
   Vec3 shading_n;  // the normal shading uses: n, or the interpolated vertex normal on n's side
   bool front;      // the ray hit the side the triangle's winding faces
   const Material* mat;
-  uint32_t tri, geomID;
+  uint32_t tri, geomID, inst;
 };
 
 inline SurfaceInteraction surface_interaction(const PassContext& ctx, const Ray& ray, const Hit& hit) {
   const Scene& scene = *ctx.scene;
-  const Triangle& tri = scene.triangles[hit.tri];
+  const Triangle tri = scene.world_triangle(hit.tri, hit.inst);
   SurfaceInteraction si;
   si.mat = &scene.materials[scene.tri_material[hit.tri]];
-  si.n = normalize(tri.normal());
+  si.n = normalize(scene.face_normal(tri, hit.inst));
   si.front = dot(si.n, ray.dir) <= 0.0f;
   if (!si.front) si.n = -si.n;  // shade the side the ray sees
   // Barycentric position: more precise than org + t*dir far from the camera.
@@ -42,6 +42,7 @@ inline SurfaceInteraction surface_interaction(const PassContext& ctx, const Ray&
   si.albedo_over_pi = si.mat->kd * std::numbers::inv_pi_v<float>;
   si.tri = hit.tri;
   si.geomID = hit.geomID;
+  si.inst = hit.inst;
   return si;
 }
 
@@ -50,7 +51,8 @@ inline SurfaceInteraction surface_interaction(const PassContext& ctx, const Ray&
 inline Vec3 interpolated_normal(const Scene& scene, const Hit& hit, Vec3 n) {
   if (scene.corner_normals.empty()) return n;
   const Vec3* c = &scene.corner_normals[3 * size_t(hit.tri)];
-  const Vec3 s = c[0] * (1.0f - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
+  Vec3 s = c[0] * (1.0f - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
+  if (hit.inst != kInvalidIndex) s = scene.instances[hit.inst].normal(s);
   const float len = length(s);
   if (!(len > 0.0f) || !std::isfinite(len)) return n;
   const Vec3 unit = s / len;

@@ -33,7 +33,7 @@ struct LightSample {
 // (the study's one shadow ray per area light); false when it cannot light `si` (it is the
 // surface's own emitter, or lies behind the surface).
 inline bool sample_lamp(const Light& light, const SurfaceInteraction& si, LightSample& out) {
-  if (light.geomID == si.geomID) return false;  // an emitter does not light itself
+  if (light.geomID == si.geomID && light.inst == si.inst) return false;  // an emitter does not light itself
   const Vec3 to_light = light.position - si.origin;
   const float d2 = dot(to_light, to_light);
   if (!(d2 > 0.0f)) return false;
@@ -120,9 +120,10 @@ class LightSampler {
   }
   // The density with which sample() finds the environment along `wi` from a surface of normal `n`.
   float pdf_environment(Vec3 n, Vec3 wi) const { return p_env_ * env_.pdf(n, wi); }
-  // The density with which sample() finds the point `to` of scene triangle `tri` from `from`.
-  float pdf_emitter(uint32_t tri, Vec3 from, Vec3 to) const {
-    return (1.0f - p_env_) * scene_->emitters.pdf(*scene_, tri, from, to);
+  // The density with which sample() finds the point `to` of scene triangle `tri` (placed by
+  // instance `inst`) from `from`.
+  float pdf_emitter(uint32_t tri, uint32_t inst, Vec3 from, Vec3 to) const {
+    return (1.0f - p_env_) * scene_->emitters.pdf(*scene_, tri, inst, from, to);
   }
   // The scene's lamps: path tracing takes the point lights among them at every vertex (an area
   // lamp's triangles are sample()'s emitters).

@@ -120,7 +120,7 @@ Vec3 path_radiance(const Accel& accel, const PassContext& ctx, Ray ray, const Pa
     if (mat.emissive() && si.front) {  // emitters shine from their front face (see Emitters)
       float w = 1.0f;
       if (nee && !unsampled) {
-        w = power_heuristic(bsdf_pdf, lights.pdf_emitter(hit.tri, ray.org, si.position));
+        w = power_heuristic(bsdf_pdf, lights.pdf_emitter(hit.tri, hit.inst, ray.org, si.position));
       }
       radiance += beta * mat.ke * w;
     }

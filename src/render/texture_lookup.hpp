@@ -28,7 +28,7 @@ inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
 inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& mat, Vec3 ns, Vec3 wo) {
   const bool normal_map = mat.normal_texture != kInvalidIndex;
   if ((!normal_map && mat.bump_texture == kInvalidIndex) || scene.corner_uvs.empty()) return ns;
-  const Triangle& tri = scene.triangles[hit.tri];
+  const Triangle tri = scene.world_triangle(hit.tri, hit.inst);
   const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float du1 = c[1].x - c[0].x, dv1 = c[1].y - c[0].y, du2 = c[2].x - c[0].x, dv2 = c[2].y - c[0].y;
   const float det = du1 * dv2 - dv1 * du2;
@@ -77,7 +77,7 @@ struct RayCone {
 // cosine `cos_incidence`: log2 of the texels its footprint spans, through the triangle's ratio of
 // texture area (in texels) to surface area.
 inline float texture_lod(const Scene& scene, const Hit& hit, const Texture& t, float width, float cos_incidence) {
-  const Triangle& tri = scene.triangles[hit.tri];
+  const Triangle tri = scene.world_triangle(hit.tri, hit.inst);
   const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float texels = std::fabs((c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y)) *
                        float(t.width()) * float(t.height());

@@ -11,15 +11,23 @@ namespace tracer {
 
 Emitters::Emitters(const Scene& scene, bool solid_angle) : solid_angle_(solid_angle) {
   std::vector<double> power;
-  for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
-    const Material& m = scene.materials[scene.tri_material[i]];
-    if (!m.emissive() || scene.triangles[i].degenerate()) continue;
-    const float area = 0.5f * length(scene.triangles[i].normal());
-    const double p = double(luminance(m.ke)) * double(area);
-    if (!(area > 0.0f) || !(p > 0.0) || !std::isfinite(p)) continue;
-    tris_.push_back(i);
-    area_.push_back(area);
-    power.push_back(p);
+  // Keys ascend: instances in order, each its mesh's triangles in order.
+  const auto add = [&](TriangleRange range, uint32_t inst) {
+    for (uint32_t i = range.first; i < range.first + range.count; ++i) {
+      const Material& m = scene.materials[scene.tri_material[i]];
+      if (!m.emissive() || scene.triangles[i].degenerate()) continue;
+      const float area = 0.5f * length(scene.world_triangle(i, inst).normal());
+      const double p = double(luminance(m.ke)) * double(area);
+      if (!(area > 0.0f) || !(p > 0.0) || !std::isfinite(p)) continue;
+      keys_.push_back(key(i, inst));
+      area_.push_back(area);
+      power.push_back(p);
+    }
+  };
+  if (!scene.instanced()) {
+    add(TriangleRange::all(scene), kInvalidIndex);
+  } else {
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) add(scene.meshes[scene.instances[i].mesh].triangles, i);
   }
   // Double sums so a million small emitters still get exact-enough probabilities.
   double total = 0.0;
@@ -33,22 +41,22 @@ Emitters::Emitters(const Scene& scene, bool solid_angle) : solid_angle_(solid_an
   if (!cdf_.empty()) cdf_.back() = 1.0f;
 }
 
-bool Emitters::by_solid_angle(const Scene& scene, uint32_t tri, Vec3 from, double& omega) const {
+bool Emitters::by_solid_angle(const Triangle& t, Vec3 from, double& omega) const {
   if (!solid_angle_) return false;
-  const Triangle& t = scene.triangles[tri];
   omega = triangle_solid_angle(from, t.v0, t.v1, t.v2);
   return omega >= kMinSolidAngle && omega <= kMaxSolidAngle;
 }
 
 bool Emitters::sample(const Scene& scene, Vec3 from, float u_select, float u1, float u2, EmitterSample& out) const {
-  if (tris_.empty()) return false;
+  if (keys_.empty()) return false;
   const size_t i =
-      std::min(size_t(std::upper_bound(cdf_.begin(), cdf_.end(), u_select) - cdf_.begin()), tris_.size() - 1);
-  const uint32_t tri = tris_[i];
-  const Triangle& t = scene.triangles[tri];
+      std::min(size_t(std::upper_bound(cdf_.begin(), cdf_.end(), u_select) - cdf_.begin()), keys_.size() - 1);
+  const auto tri = uint32_t(keys_[i]);
+  const auto inst = uint32_t((keys_[i] >> 32) - 1);
+  const Triangle t = scene.world_triangle(tri, inst);
   double omega = 0.0;
-  if (by_solid_angle(scene, tri, from, omega)) {
-    const Vec3 n = t.normal();
+  if (by_solid_angle(t, from, omega)) {
+    const Vec3 n = scene.face_normal(t, inst);
     if (!(dot(n, from - t.v0) > 0.0f)) return false;  // behind the emitting face
     Vec3 w;
     if (!sample_spherical_triangle(from, t.v0, t.v1, t.v2, u1, u2, w)) return false;
@@ -70,26 +78,26 @@ bool Emitters::sample(const Scene& scene, Vec3 from, float u_select, float u1, f
   if (!(d2 > 0.0f)) return false;
   out.distance = std::sqrt(d2);
   out.wi = to / out.distance;
-  const float cos_light = -dot(normalize(t.normal()), out.wi);  // the front face must face `from`
+  const float cos_light = -dot(normalize(scene.face_normal(t, inst)), out.wi);  // the front face must face `from`
   if (!(cos_light > 0.0f)) return false;
   out.pdf = pmf_[i] * d2 / (area_[i] * cos_light);
   out.radiance = scene.materials[scene.tri_material[tri]].ke;
   return std::isfinite(out.pdf);
 }
 
-float Emitters::pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const {
-  const auto it = std::lower_bound(tris_.begin(), tris_.end(), tri);
-  if (it == tris_.end() || *it != tri) return 0.0f;
-  const size_t i = size_t(it - tris_.begin());
+float Emitters::pdf(const Scene& scene, uint32_t tri, uint32_t inst, Vec3 from, Vec3 to) const {
+  const auto it = std::lower_bound(keys_.begin(), keys_.end(), key(tri, inst));
+  if (it == keys_.end() || *it != key(tri, inst)) return 0.0f;
+  const size_t i = size_t(it - keys_.begin());
+  const Triangle t = scene.world_triangle(tri, inst);
   double omega = 0.0;
-  if (by_solid_angle(scene, tri, from, omega)) {
-    return dot(scene.triangles[tri].normal(), from - scene.triangles[tri].v0) > 0.0f ? float(double(pmf_[i]) / omega)
-                                                                                     : 0.0f;
+  if (by_solid_angle(t, from, omega)) {
+    return dot(scene.face_normal(t, inst), from - t.v0) > 0.0f ? float(double(pmf_[i]) / omega) : 0.0f;
   }
   const Vec3 d = to - from;
   const float d2 = dot(d, d);
   if (!(d2 > 0.0f)) return 0.0f;
-  const float cos_light = -dot(normalize(scene.triangles[tri].normal()), d / std::sqrt(d2));
+  const float cos_light = -dot(normalize(scene.face_normal(t, inst)), d / std::sqrt(d2));
   return cos_light > 0.0f ? pmf_[i] * d2 / (area_[i] * cos_light) : 0.0f;
 }
 

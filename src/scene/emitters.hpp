@@ -14,6 +14,7 @@
 namespace tracer {
 
 struct Scene;
+struct Triangle;
 
 struct EmitterSample {
   Vec3 point;  // on the emitter
@@ -29,15 +30,16 @@ class Emitters {
   // Every non-degenerate triangle with an emissive material. `solid_angle` false: every point by
   // area (the estimator before solid-angle sampling, which tests compare against).
   explicit Emitters(const Scene& scene, bool solid_angle = true);
-  bool empty() const { return tris_.empty(); }
-  size_t size() const { return tris_.size(); }
+  bool empty() const { return keys_.empty(); }
+  size_t size() const { return keys_.size(); }
   // A point on an emitter seen from `from`, by three uniform numbers; false if it has no solid
   // angle there (seen edge-on or from behind, or `from` lies on it).
   bool sample(const Scene& scene, Vec3 from, float u_select, float u1, float u2, EmitterSample& out) const;
   // The solid-angle density with which sample() picks the point `to` on scene triangle `tri`
-  // from `from`: 0 when `tri` is not one of the emitters.
-  float pdf(const Scene& scene, uint32_t tri, Vec3 from, Vec3 to) const;
-  uint64_t memory_bytes() const { return tris_.capacity() * 4 * sizeof(float); }
+  // (placed by instance `inst`, kInvalidIndex in a flat scene) from `from`: 0 when it is not one
+  // of the emitters.
+  float pdf(const Scene& scene, uint32_t tri, uint32_t inst, Vec3 from, Vec3 to) const;
+  uint64_t memory_bytes() const { return keys_.capacity() * (sizeof(uint64_t) + 3 * sizeof(float)); }
 
   // Solid angles within which a triangle is sampled by solid angle: below, its directions are
   // nearly parallel and area sampling is as good (and the spherical angles lose precision);
@@ -45,12 +47,14 @@ class Emitters {
   static constexpr double kMinSolidAngle = 3e-4, kMaxSolidAngle = 6.22;
 
  private:
-  // Whether triangle `tri` is sampled by solid angle from `from` (its solid angle there).
-  bool by_solid_angle(const Scene& scene, uint32_t tri, Vec3 from, double& omega) const;
+  // An emitter's key: its instance + 1 (0 in a flat scene) above its scene triangle index.
+  static uint64_t key(uint32_t tri, uint32_t inst) { return (uint64_t(inst + 1) << 32) | tri; }
+  // Whether world triangle `t` is sampled by solid angle from `from` (its solid angle there).
+  bool by_solid_angle(const Triangle& t, Vec3 from, double& omega) const;
   bool solid_angle_ = true;
-  std::vector<uint32_t> tris_;  // scene triangle indices, ascending
-  std::vector<float> cdf_;      // cdf_[i]: the probability of choosing one of tris_[0..i]
-  std::vector<float> pmf_;      // probability of choosing tris_[i]
+  std::vector<uint64_t> keys_;  // key() of each emitter, ascending
+  std::vector<float> cdf_;      // cdf_[i]: the probability of choosing one of keys_[0..i]
+  std::vector<float> pmf_;      // probability of choosing keys_[i]
   std::vector<float> area_;
 };
 

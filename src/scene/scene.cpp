@@ -35,46 +35,78 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
   geometries.push_back(std::move(g));
 }
 
+Instance make_instance(uint32_t mesh, const Aabb& mesh_box, const Affine& world) {
+  Instance in;
+  in.mesh = mesh;
+  in.to_world = Transform::of(world);
+  in.to_object = Transform::of(world.inverse());
+  in.mirrors = world.determinant() < 0.0;
+  for (int k = 0; k < 8 && !mesh_box.empty(); ++k) {
+    const Vec3 corner{(k & 1) ? mesh_box.hi.x : mesh_box.lo.x, (k & 2) ? mesh_box.hi.y : mesh_box.lo.y,
+                      (k & 4) ? mesh_box.hi.z : mesh_box.lo.z};
+    in.bounds.extend(world.point(corner));
+  }
+  return in;
+}
+
+uint64_t Scene::instanced_size() const {
+  if (!instanced()) return size();
+  uint64_t n = 0;
+  for (const Instance& in : instances) n += meshes[in.mesh].triangles.count;
+  return n;
+}
+
 void Scene::finalize() {
   bounds = Aabb{};
   degenerate_count = 0;
   for (const Triangle& t : triangles) {
-    bounds.extend(t.bounds());
+    if (!instanced()) bounds.extend(t.bounds());
     degenerate_count += t.degenerate() ? 1 : 0;
   }
-  // One area light per (geometry, emissive material): the Cornell lamp is one quad, one light.
+  for (const Instance& in : instances) bounds.extend(in.bounds);
+  // One area light per (geometry, emissive material) and instance: the Cornell lamp is one quad,
+  // one light.
   std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
   struct Accum {
     Vec3 weighted_centroid, normal;
     float area = 0;
     Vec3 ke;
   };
-  std::map<std::pair<uint32_t, uint32_t>, Accum> by_source;
-  for (size_t i = 0; i < triangles.size(); ++i) {
-    const Material& m = materials[tri_material[i]];
-    if (!m.emissive() || triangles[i].degenerate()) continue;
-    Accum& a = by_source[{tri_geom[i], tri_material[i]}];
-    const Vec3 n = triangles[i].normal();
-    const float area = 0.5f * length(n);
-    a.weighted_centroid += triangles[i].centroid() * area;
-    a.normal += n * 0.5f;
-    a.area += area;
-    a.ke = m.ke;
-  }
-  for (const auto& [key, a] : by_source) {
-    if (a.area <= 0.0f) continue;
-    Light l;
-    l.position = a.weighted_centroid / a.area;
-    const float n_len = length(a.normal);
-    l.normal = n_len > 0.0f ? a.normal / n_len : Vec3{0.0f, -1.0f, 0.0f};
-    l.power = a.ke * a.area;
-    l.area = a.area;
-    l.geomID = key.first;
-    if (!is_finite(l.position) || !is_finite(l.power)) {
-      throw InputError(source + ": the emissive surface of geometry " + std::to_string(key.first) + " (material " +
-                       std::to_string(key.second) + ") has a light of non-finite position or power");
+  const auto add_lights = [&](TriangleRange range, uint32_t inst) {
+    std::map<std::pair<uint32_t, uint32_t>, Accum> by_source;
+    for (size_t i = range.first; i < size_t(range.first) + range.count; ++i) {
+      const Material& m = materials[tri_material[i]];
+      if (!m.emissive() || triangles[i].degenerate()) continue;
+      Accum& a = by_source[{tri_geom[i], tri_material[i]}];
+      const Triangle t = world_triangle(uint32_t(i), inst);
+      const Vec3 n = face_normal(t, inst);
+      const float area = 0.5f * length(n);
+      a.weighted_centroid += t.centroid() * area;
+      a.normal += n * 0.5f;
+      a.area += area;
+      a.ke = m.ke;
     }
-    lights.push_back(l);
+    for (const auto& [key, a] : by_source) {
+      if (a.area <= 0.0f) continue;
+      Light l;
+      l.position = a.weighted_centroid / a.area;
+      const float n_len = length(a.normal);
+      l.normal = n_len > 0.0f ? a.normal / n_len : Vec3{0.0f, -1.0f, 0.0f};
+      l.power = a.ke * a.area;
+      l.area = a.area;
+      l.geomID = key.first;
+      l.inst = inst;
+      if (!is_finite(l.position) || !is_finite(l.power)) {
+        throw InputError(source + ": the emissive surface of geometry " + std::to_string(key.first) + " (material " +
+                         std::to_string(key.second) + ") has a light of non-finite position or power");
+      }
+      lights.push_back(l);
+    }
+  };
+  if (!instanced()) {
+    add_lights(TriangleRange::all(*this), kInvalidIndex);
+  } else {
+    for (uint32_t i = 0; i < instances.size(); ++i) add_lights(meshes[instances[i].mesh].triangles, i);
   }
   emitters = Emitters(*this);
 }
@@ -83,7 +115,8 @@ uint64_t Scene::memory_bytes() const {
   uint64_t bytes = triangles.capacity() * sizeof(Triangle) +
                    (tri_geom.capacity() + tri_prim.capacity() + tri_material.capacity()) * sizeof(uint32_t) +
                    corner_normals.capacity() * sizeof(Vec3) + corner_uvs.capacity() * sizeof(Vec2) +
-                   geometries.capacity() * sizeof(Geometry) + emitters.memory_bytes();
+                   geometries.capacity() * sizeof(Geometry) + emitters.memory_bytes() +
+                   meshes.capacity() * sizeof(Mesh) + instances.capacity() * sizeof(Instance);
   for (const Texture& t : textures) bytes += t.srgb().size() * 4 / 3;  // and its mip levels
   return bytes;
 }

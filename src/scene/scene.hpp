@@ -13,6 +13,7 @@
 #include "math/vec.hpp"
 #include "scene/emitters.hpp"
 #include "scene/environment_map.hpp"
+#include "scene/instances.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -78,6 +79,7 @@ struct Light {
   Vec3 power;
   float area = 0.0f;                // emitting area (0 for point lights)
   uint32_t geomID = kInvalidIndex;  // the emitting geometry, or kInvalidIndex for point lights
+  uint32_t inst = kInvalidIndex;    // the instance placing it (instanced scenes)
   bool is_point() const { return normal == Vec3{0.0f}; }
 };
 
@@ -121,11 +123,33 @@ struct Scene {
   std::optional<CameraSpec> camera;  // a camera the scene itself suggests (the built-in box)
   std::vector<CameraSpec> cameras;   // the cameras the file places (glTF), in node order
 
-  size_t size() const { return triangles.size(); }
+  // Instances (glTF's nodes placing one mesh several times): each mesh's triangles once, in its
+  // own space, and the instances that place them. Empty: the triangles are the world.
+  std::vector<Mesh> meshes;
+  std::vector<Instance> instances;
+
+  size_t size() const { return triangles.size(); }  // unique triangles
+  bool instanced() const { return !instances.empty(); }
+  // The triangles the instances place (each mesh's count once per instance); size() when flat.
+  uint64_t instanced_size() const;
   // The intensity of a point light when none is given (--light, a view's light): (diagonal / 2)^2.
   float default_light_intensity() const {
     const float diag = length(bounds.extent());
     return 0.25f * diag * diag;
+  }
+  // Triangle `tri` where instance `inst` places it; as stored when inst is kInvalidIndex (a flat
+  // scene's hits).
+  Triangle world_triangle(uint32_t tri, uint32_t inst) const {
+    const Triangle& t = triangles[tri];
+    if (inst == kInvalidIndex) return t;
+    const Transform& m = instances[inst].to_world;
+    return {m.point(t.v0), m.point(t.v1), m.point(t.v2)};
+  }
+  // The geometric normal (unnormalised) of `placed`, world_triangle(tri, inst), on its front side:
+  // a mirroring instance reverses the winding (as append_mesh reverses a mirrored mesh's corners).
+  Vec3 face_normal(const Triangle& placed, uint32_t inst) const {
+    const Vec3 n = placed.normal();
+    return inst != kInvalidIndex && instances[inst].mirrors ? -n : n;
   }
   // Appends a geometry from an indexed mesh; material is an index into `materials`.
   void add_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices,
@@ -137,8 +161,11 @@ struct Scene {
   static constexpr uint64_t bytes_per_triangle(bool normals, bool uvs) {
     return sizeof(Triangle) + 3 * sizeof(uint32_t) + (normals ? 3 * sizeof(Vec3) : 0) + (uvs ? 3 * sizeof(Vec2) : 0);
   }
-  // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials.
+  // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials
+  // (each instance of an emissive mesh its own lights).
   void finalize();
 };
+
+inline TriangleRange TriangleRange::all(const Scene& scene) { return {0, uint32_t(scene.size())}; }
 
 }  // namespace tracer
