@@ -7,9 +7,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # folder:layer, lowest first; accel's sub-layers (kernels, bvh, wide_bvh, builders, then accel/
-# itself) within its layer 3.
+# two_level, then accel/ itself) within its layer 3.
 layers="base:0 math:1 scene:2 parallel:2 importers:3 film:3 accel:3 io:4 shade:4 denoise:4 render:5 frontend:6 view:7 mpi:7 cli:8"
-sublayers="accel/kernels:0 accel/bvh:1 accel/wide_bvh:2 accel/builders:3 accel:4"
+sublayers="accel/kernels:0 accel/bvh:1 accel/wide_bvh:2 accel/builders:3 accel/two_level:4 accel:5"
 declare -A rank
 for entry in $layers; do rank[${entry%%:*}]=$((${entry##*:} * 10)); done
 for entry in $sublayers; do rank[${entry%%:*}]=$((rank[accel] + ${entry##*:})); done

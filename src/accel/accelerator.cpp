@@ -10,6 +10,7 @@ static_assert(RayAccelerator<BruteForce>);
 static_assert(RayAccelerator<Bvh>);
 static_assert(RayAccelerator<WideBvh>);
 static_assert(RayAccelerator<SimdBruteForce>);
+static_assert(RayAccelerator<TwoLevelBvh>);
 
 bool embree_available() {
 #ifdef TRACER_HAVE_EMBREE
@@ -32,6 +33,21 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
   Accelerator acc;
   acc.kind = options.kind;
   const auto start = std::chrono::steady_clock::now();
+  if (scene.instanced()) {
+    if (!traces_instances(options.kind)) {
+      throw UsageError(
+          std::string("--accel ") + std::string(name_of<AccelKind>(kAccelKindNames, options.kind)) + ": " +
+          scene.source +
+          " places meshes by instances, which only bvh8 traces (load it for this accelerator to expand them)");
+    }
+    BvhBuildOptions bvh = options.bvh;
+    const bool high = options.quality == BuildQuality::High;
+    bvh.split_budget = high ? kHighSplitBudget : 0.0f;
+    acc.impl = std::make_unique<AccelVariant>(std::in_place_type<TwoLevelBvh>, scene, bvh);
+    acc.name = "bvh8-" + std::get<TwoLevelBvh>(*acc.impl).simd().name() + (high ? "-high" : "") + "-two-level";
+    acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return acc;
+  }
   switch (options.kind) {
     case AccelKind::Brute:
       acc.impl = std::make_unique<AccelVariant>(std::in_place_type<BruteForce>, scene);

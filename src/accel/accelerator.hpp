@@ -12,6 +12,7 @@
 
 #include "accel/brute_force.hpp"
 #include "accel/bvh/bvh.hpp"
+#include "accel/two_level/two_level_bvh.hpp"
 #include "accel/wide_bvh/wide_bvh.hpp"
 #ifdef TRACER_HAVE_EMBREE
 #include "accel/embree_accel.hpp"
@@ -70,7 +71,7 @@ struct AccelOptions {
   BvhBuildOptions bvh;
 };
 
-using AccelVariant = std::variant<BruteForce, SimdBruteForce, Bvh, WideBvh
+using AccelVariant = std::variant<BruteForce, SimdBruteForce, Bvh, WideBvh, TwoLevelBvh
 #ifdef TRACER_HAVE_EMBREE
                                   ,
                                   EmbreeAccel
@@ -88,6 +89,8 @@ struct Accelerator {
     return std::visit(std::forward<F>(f), *impl);
   }
   size_t memory_bytes() const;
+  // The two-level tree of an instanced scene.
+  bool instanced() const { return std::holds_alternative<TwoLevelBvh>(*impl); }
   // The binary BVH's shape (nodes, leaves, depth, SAH cost); empty for the other accelerators.
   std::optional<BvhStats> bvh_stats() const;
 };
@@ -100,8 +103,13 @@ inline bool traces_rays_together(AccelKind kind) {
   return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || is_embree(kind);
 }
 
-// Builds the accelerator `options` asks for, timing the build. Throws UsageError if it is not
-// compiled in (Embree).
+// Whether `kind` traces an instanced scene as instances (a two-level tree); a scene loaded for
+// the others has its instances expanded.
+inline bool traces_instances(AccelKind kind) { return kind == AccelKind::Bvh8; }
+
+// Builds the accelerator `options` asks for, timing the build: for an instanced scene, its
+// two-level form (bvh8; the others throw UsageError naming the ones that trace instances). Throws
+// UsageError if it is not compiled in (Embree).
 Accelerator build_accelerator(const Scene& scene, const AccelOptions& options);
 
 }  // namespace tracer

@@ -27,7 +27,10 @@ Emitters::Emitters(const Scene& scene, bool solid_angle) : solid_angle_(solid_an
   if (!scene.instanced()) {
     add(TriangleRange::all(scene), kInvalidIndex);
   } else {
-    for (uint32_t i = 0; i < scene.instances.size(); ++i) add(scene.meshes[scene.instances[i].mesh].triangles, i);
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+      const Mesh& m = scene.meshes[scene.instances[i].mesh];
+      if (m.emissive) add(m.triangles, i);
+    }
   }
   // Double sums so a million small emitters still get exact-enough probabilities.
   double total = 0.0;

@@ -52,21 +52,22 @@ struct Transform {
 struct Mesh {
   std::string name;
   TriangleRange triangles;
-  Aabb bounds;
+  Aabb bounds;            // of its non-degenerate triangles (Scene::finalize)
+  bool emissive = false;  // holds a triangle of an emissive material (Scene::finalize)
 };
 
 // One placement of a mesh. to_object is to_world's inverse, computed in double.
 struct Instance {
   uint32_t mesh = 0;
   Transform to_world, to_object;
-  Aabb bounds;           // in world space: the mesh's box's corners moved
+  Aabb bounds;           // in world space: the mesh box moved, padded (Scene::finalize)
   bool mirrors = false;  // to_world's determinant is negative: it reverses the triangles' winding
 
   // A world-space normal of the object-space normal n (unnormalised).
   Vec3 normal(Vec3 n) const { return to_object.transposed(n); }
 };
 
-// An instance of `mesh` (with box `mesh_box`) placed by `world`, which must be invertible.
-Instance make_instance(uint32_t mesh, const Aabb& mesh_box, const Affine& world);
+// An instance of `mesh` placed by `world`, which must be invertible; its box is Scene::finalize's.
+Instance make_instance(uint32_t mesh, const Affine& world);
 
 }  // namespace tracer

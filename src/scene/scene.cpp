@@ -1,5 +1,6 @@
 #include "scene/scene.hpp"
 
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -35,19 +36,32 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
   geometries.push_back(std::move(g));
 }
 
-Instance make_instance(uint32_t mesh, const Aabb& mesh_box, const Affine& world) {
+Instance make_instance(uint32_t mesh, const Affine& world) {
   Instance in;
   in.mesh = mesh;
   in.to_world = Transform::of(world);
   in.to_object = Transform::of(world.inverse());
   in.mirrors = world.determinant() < 0.0;
-  for (int k = 0; k < 8 && !mesh_box.empty(); ++k) {
-    const Vec3 corner{(k & 1) ? mesh_box.hi.x : mesh_box.lo.x, (k & 2) ? mesh_box.hi.y : mesh_box.lo.y,
-                      (k & 4) ? mesh_box.hi.z : mesh_box.lo.z};
-    in.bounds.extend(world.point(corner));
-  }
   return in;
 }
+
+namespace {
+
+// The world box of `box` moved by `m`: its corners' box, widened by a few float steps of its
+// size, as the corners moved in float may land a rounding inside the moved triangles.
+Aabb moved_box(const Aabb& box, const Transform& m) {
+  Aabb out;
+  if (box.empty()) return out;
+  for (int k = 0; k < 8; ++k) {
+    out.extend(m.point({(k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z}));
+  }
+  const float pad = 4.0f * std::numeric_limits<float>::epsilon() * max_component(max(abs(out.lo), abs(out.hi)));
+  out.lo = out.lo - Vec3{pad};
+  out.hi = out.hi + Vec3{pad};
+  return out;
+}
+
+}  // namespace
 
 uint64_t Scene::instanced_size() const {
   if (!instanced()) return size();
@@ -63,7 +77,18 @@ void Scene::finalize() {
     if (!instanced()) bounds.extend(t.bounds());
     degenerate_count += t.degenerate() ? 1 : 0;
   }
-  for (const Instance& in : instances) bounds.extend(in.bounds);
+  for (Mesh& m : meshes) {
+    m.bounds = Aabb{};
+    m.emissive = false;
+    for (uint32_t i = m.triangles.first; i < m.triangles.first + m.triangles.count; ++i) {
+      if (!triangles[i].degenerate()) m.bounds.extend(triangles[i].bounds());
+      m.emissive = m.emissive || materials[tri_material[i]].emissive();
+    }
+  }
+  for (Instance& in : instances) {
+    in.bounds = moved_box(meshes[in.mesh].bounds, in.to_world);
+    bounds.extend(in.bounds);
+  }
   // One area light per (geometry, emissive material) and instance: the Cornell lamp is one quad,
   // one light.
   std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
@@ -106,7 +131,9 @@ void Scene::finalize() {
   if (!instanced()) {
     add_lights(TriangleRange::all(*this), kInvalidIndex);
   } else {
-    for (uint32_t i = 0; i < instances.size(); ++i) add_lights(meshes[instances[i].mesh].triangles, i);
+    for (uint32_t i = 0; i < instances.size(); ++i) {
+      if (meshes[instances[i].mesh].emissive) add_lights(meshes[instances[i].mesh].triangles, i);
+    }
   }
   emitters = Emitters(*this);
 }

@@ -13,7 +13,12 @@ namespace tracer {
 
 struct SceneInfo {
   std::string source;
-  uint64_t triangles = 0, degenerate = 0, vertices = 0, geometries = 0;
+  uint64_t triangles = 0, degenerate = 0, vertices = 0, geometries = 0;  // triangles: as placed
+  // An instanced scene's meshes (each kept once), their triangles and the instances placing them;
+  // all 0 for a flat scene.
+  uint64_t unique_triangles = 0, meshes = 0, instances = 0;
+  // The scene's arrays and an accelerator's (bvh8's at medium quality) over them, estimated.
+  uint64_t estimated_bytes = 0;
   std::vector<std::string> materials;
   std::vector<Light> lights;          // every light listed
   uint64_t unlisted_area_lights = 0;  // emissive geometries counted but not placed (a glTF's)
@@ -24,7 +29,12 @@ struct SceneInfo {
 inline SceneInfo info_of(const Scene& scene) {
   SceneInfo info;
   info.source = scene.source;
-  info.triangles = scene.size();
+  info.triangles = scene.instanced_size();
+  if (scene.instanced()) {
+    info.unique_triangles = scene.size();
+    info.meshes = scene.meshes.size();
+    info.instances = scene.instances.size();
+  }
   info.degenerate = scene.degenerate_count;
   info.vertices = scene.vertex_count;
   info.geometries = scene.geometries.size();

@@ -205,7 +205,10 @@ WideBvh::WideBvh(const Scene& scene, const BvhBuildOptions& options, const Execu
     : WideBvh(scene, TriangleRange::all(scene), options, exec) {}
 
 WideBvh::WideBvh(const Scene& scene, TriangleRange range, const BvhBuildOptions& options_in, const Executor& exec)
-    : scene_(&scene), spatial_splits_(options_in.split_budget > 0.0f), simd_(SimdDispatch::of(options_in.simd)) {
+    : scene_(&scene),
+      range_(range),
+      spatial_splits_(options_in.split_budget > 0.0f),
+      simd_(SimdDispatch::of(options_in.simd)) {
   BvhBuildOptions options = options_in;
   // Nodes of more than one pack are always split, so the SAH never weighs a leaf larger than one.
   options.max_leaf = std::min(options.max_leaf, kWideWidth);

@@ -75,6 +75,7 @@ class WideBvh {
 
  private:
   const Scene* scene_;
+  TriangleRange range_;  // the scene's triangles it holds
   WideNodeArray nodes_;
   PackArray packs_;
   Aabb bounds_;

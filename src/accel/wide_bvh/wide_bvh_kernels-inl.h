@@ -246,6 +246,38 @@ HWY_INLINE bool Descend(const WideNode& n, uint32_t bits, const float* t, StackE
   return true;
 }
 
+// Closest hit for one ray in the whole tree, nearer than hit.t (updated: t, u, v, tri; hits at
+// hit.t tie to the lower triangle index).
+template <class Count>
+HWY_INLINE void ClosestInTree(const WideBvh& bvh, const Ray& ray, Hit& hit, Count count) {
+  const auto& nodes = bvh.nodes();
+  if (nodes.empty()) return;
+  const NodeRay wr{WideRay(ray)};
+  const RayShear ray_shear(ray);
+  const PackRay shear(ray_shear);
+  const Triangle* tris = bvh.scene().triangles.data();
+  const TrianglePack* packs = bvh.packs().data();
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  HWY_ALIGN float t[kWideWidth];
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      count.node(1);
+      const WideNode& n = nodes[cur.child];
+      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
+    } else {
+      count.pack(1, cur.count);
+      ClosestInPack(packs[cur.child], shear, tris, ray.tnear, hit);
+    }
+    // Pop, skipping entries now beyond the closest hit (<=: ties still count).
+    do {
+      if (sp == 0) return;
+      cur = stack[--sp];
+    } while (!(cur.t <= hit.t * SlabGuards::kTieGuard));
+  }
+}
+
 // Any hit for one ray below `start` (a node, or a leaf pack when start.count > 0).
 template <class Count>
 HWY_INLINE bool OccludedBelow(const WideBvh& bvh, const WideRay& wr, const RayShear& shear, float tnear, float tfar,

@@ -17,32 +17,8 @@ bool IntersectWideT(const WideBvh& bvh, const Ray& ray, Hit& hit, Count count) {
   count.rays(1);
   hit = Hit{};
   hit.t = ray.tfar;
-  const auto& nodes = bvh.nodes();
-  if (nodes.empty()) return false;
-  const NodeRay wr{WideRay(ray)};
-  const RayShear ray_shear(ray);
-  const PackRay shear(ray_shear);
-  const Triangle* tris = bvh.scene().triangles.data();
-  const TrianglePack* packs = bvh.packs().data();
-  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
-  int sp = 0;
-  HWY_ALIGN float t[kWideWidth];
-  StackEntry cur{0, 0, ray.tnear};
-  for (;;) {
-    if (cur.count == 0) {
-      count.node(1);
-      const WideNode& n = nodes[cur.child];
-      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
-    } else {
-      count.pack(1, cur.count);
-      ClosestInPack(packs[cur.child], shear, tris, ray.tnear, hit);
-    }
-    // Pop, skipping entries now beyond the closest hit (<=: ties still count).
-    do {
-      if (sp == 0) return finish_hit(bvh.scene(), hit);
-      cur = stack[--sp];
-    } while (!(cur.t <= hit.t * SlabGuards::kTieGuard));
-  }
+  ClosestInTree(bvh, ray, hit, count);
+  return finish_hit(bvh.scene(), hit);
 }
 
 bool IntersectWide(const WideBvh& bvh, const Ray& ray, Hit& hit) { return IntersectWideT(bvh, ray, hit, NoCount{}); }

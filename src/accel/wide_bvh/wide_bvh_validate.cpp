@@ -10,9 +10,10 @@
 namespace tracer {
 
 std::string WideBvh::validate() const {
+  const uint32_t first = range_.first, end = range_.first + range_.count;
   if (nodes_.empty()) {
-    for (const Triangle& t : scene_->triangles) {
-      if (!t.degenerate()) return "triangles but no nodes";
+    for (uint32_t i = first; i < end; ++i) {
+      if (!scene_->triangles[i].degenerate()) return "triangles but no nodes";
     }
     return "";
   }
@@ -51,7 +52,7 @@ std::string WideBvh::validate() const {
             continue;
           }
           const uint32_t k = pk.id[lane];
-          if (k >= scene_->size()) return "pack lane's triangle out of range";
+          if (k < first || k >= end) return "pack lane's triangle out of range";
           const Triangle& t = scene_->triangles[k];
           if (pk.v[0][0][lane] != t.v0.x || pk.v[2][2][lane] != t.v2.z) return "pack lane differs from its triangle";
           if (spatial_splits_) {
@@ -69,7 +70,7 @@ std::string WideBvh::validate() const {
       }
     }
   }
-  for (size_t i = 0; i < seen.size(); ++i) {
+  for (size_t i = first; i < end; ++i) {
     const bool degenerate = scene_->triangles[i].degenerate();
     const bool right = spatial_splits_ ? (seen[i] > 0) != degenerate : seen[i] == (degenerate ? 0u : 1u);
     if (!right) return "triangle " + std::to_string(i) + " appears in " + std::to_string(seen[i]) + " leaves";

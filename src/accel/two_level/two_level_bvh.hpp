@@ -1,0 +1,48 @@
+// The two-level tree of an instanced scene: an 8-wide BVH per mesh over its own triangles (the
+// bottom level, built once however many instances place it) and an 8-wide tree over the
+// instances' world boxes (the top level, one instance per leaf). A ray reaching an instance is
+// moved into its mesh's space by the inverse transform (direction unnormalised, so distances
+// along it are the world ray's) and traced there with the 8-wide BVH's own kernels.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "accel/wide_bvh/wide_bvh.hpp"
+
+namespace tracer {
+
+class TwoLevelBvh {
+ public:
+  // Builds a tree per mesh of scene.meshes (meshes in parallel, and each in parallel where the
+  // executor is data-parallel) and the tree over scene.instances.
+  TwoLevelBvh(const Scene& scene, const BvhBuildOptions& options);
+  TwoLevelBvh(const Scene& scene, const BvhBuildOptions& options, const Executor& exec);
+
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+  // The same queries, counting both levels' nodes (and the meshes' packs) into `counts`.
+  bool intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const;
+  bool occluded(const Ray& ray, TraversalCounts& counts) const;
+
+  const Scene& scene() const { return *scene_; }
+  const WideNodeArray& top_nodes() const { return top_; }  // a leaf child's `child`: its instance
+  const WideBvh& mesh_tree(uint32_t mesh) const { return *meshes_[mesh]; }
+  std::span<const Instance> instances() const { return scene_->instances; }
+  size_t memory_bytes() const;
+  // Every top-level child box contains its instance's box or subtree, every instance with a
+  // non-empty box is in exactly one leaf, and each mesh's tree is valid.
+  std::string validate() const;
+  const SimdDispatch& simd() const { return simd_; }
+
+ private:
+  const Scene* scene_;
+  std::vector<std::unique_ptr<WideBvh>> meshes_;
+  WideNodeArray top_;
+  SimdDispatch simd_;
+};
+
+}  // namespace tracer

@@ -1,0 +1,129 @@
+// The two-level tree's single-ray kernels, closest hit and any hit, compiled once per SIMD
+// target: the top level walked with the 8-wide BVH's node test, each instance reached traced in
+// its mesh's tree with the same kernels the flat tree runs.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/two_level/two_level_traverse.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "accel/two_level/two_level_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_kernels-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace tracer {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// The ray in instance `in`'s mesh space, up to `tfar`: origin and direction moved by the inverse
+// transform, the direction not renormalised, so t measures the same points in both spaces.
+HWY_INLINE Ray ToObject(const Instance& in, const Ray& ray, float tfar) {
+  Ray local;
+  local.org = in.to_object.point(ray.org);
+  local.dir = in.to_object.vector(ray.dir);
+  local.tnear = ray.tnear;
+  local.tfar = tfar;
+  return local;
+}
+
+template <class Count>
+bool IntersectTwoLevelT(const TwoLevelBvh& tl, const Ray& ray, Hit& hit, Count count) {
+  count.rays(1);
+  hit = Hit{};
+  hit.t = ray.tfar;
+  const WideNodeArray& nodes = tl.top_nodes();
+  if (nodes.empty()) return false;
+  const std::span<const Instance> instances = tl.instances();
+  const NodeRay wr{WideRay(ray)};
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  HWY_ALIGN float t[kWideWidth];
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      count.node(1);
+      const WideNode& n = nodes[cur.child];
+      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
+    } else {
+      const Instance& in = instances[cur.child];
+      const float t_before = hit.t;
+      const uint32_t tri_before = hit.tri;
+      ClosestInTree(tl.mesh_tree(in.mesh), ToObject(in, ray, hit.t), hit, count);
+      if (hit.t != t_before || hit.tri != tri_before) hit.inst = cur.child;
+    }
+    do {
+      if (sp == 0) return finish_hit(tl.scene(), hit);
+      cur = stack[--sp];
+    } while (!(cur.t <= hit.t * SlabGuards::kTieGuard));
+  }
+}
+
+template <class Count>
+bool OccludedTwoLevelT(const TwoLevelBvh& tl, const Ray& ray, Count count) {
+  count.rays(1);
+  const WideNodeArray& nodes = tl.top_nodes();
+  if (nodes.empty()) return false;
+  const std::span<const Instance> instances = tl.instances();
+  const NodeRay wr{WideRay(ray)};
+  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  HWY_ALIGN float t[kWideWidth];
+  StackEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      count.node(1);
+      const WideNode& n = nodes[cur.child];
+      // Any hit ends the query: the children in slot order, no sort.
+      for (uint32_t bits = TestChildren(n, wr, ray.tnear, ray.tfar, t); bits; bits &= bits - 1) {
+        const int c = __builtin_ctz(bits);
+        stack[sp++] = {n.child[c], n.count[c], 0.0f};
+      }
+    } else {
+      const Instance& in = instances[cur.child];
+      const WideBvh& mesh = tl.mesh_tree(in.mesh);
+      const Ray local = ToObject(in, ray, ray.tfar);
+      if (OccludedBelow(mesh, WideRay(local), RayShear(local), local.tnear, local.tfar, StackEntry{0, 0, local.tnear},
+                        count)) {
+        return true;
+      }
+    }
+    if (sp == 0) return false;
+    cur = stack[--sp];
+  }
+}
+
+bool IntersectTwoLevel(const TwoLevelBvh& tl, const Ray& ray, Hit& hit) {
+  return IntersectTwoLevelT(tl, ray, hit, NoCount{});
+}
+bool IntersectTwoLevelCounted(const TwoLevelBvh& tl, const Ray& ray, Hit& hit, TraversalCounts* counts) {
+  return IntersectTwoLevelT(tl, ray, hit, CountInto{counts});
+}
+bool OccludedTwoLevel(const TwoLevelBvh& tl, const Ray& ray) { return OccludedTwoLevelT(tl, ray, NoCount{}); }
+bool OccludedTwoLevelCounted(const TwoLevelBvh& tl, const Ray& ray, TraversalCounts* counts) {
+  return OccludedTwoLevelT(tl, ray, CountInto{counts});
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace tracer
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace tracer {
+
+HWY_EXPORT(IntersectTwoLevel);
+HWY_EXPORT(IntersectTwoLevelCounted);
+HWY_EXPORT(OccludedTwoLevel);
+HWY_EXPORT(OccludedTwoLevelCounted);
+
+bool TwoLevelBvh::intersect(const Ray& ray, Hit& hit) const {
+  return SIMD_DISPATCH(simd_, IntersectTwoLevel)(*this, ray, hit);
+}
+bool TwoLevelBvh::occluded(const Ray& ray) const { return SIMD_DISPATCH(simd_, OccludedTwoLevel)(*this, ray); }
+bool TwoLevelBvh::intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const {
+  return SIMD_DISPATCH(simd_, IntersectTwoLevelCounted)(*this, ray, hit, &counts);
+}
+bool TwoLevelBvh::occluded(const Ray& ray, TraversalCounts& counts) const {
+  return SIMD_DISPATCH(simd_, OccludedTwoLevelCounted)(*this, ray, &counts);
+}
+
+}  // namespace tracer
+#endif  // HWY_ONCE
