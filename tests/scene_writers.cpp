@@ -159,7 +159,8 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
   }
   use_extensions(m);
   tg::Scene root;
-  for (const Geometry& geom : scene.geometries) {
+  for (uint32_t g = 0; g < scene.geometries.size(); ++g) {
+    const Geometry& geom = scene.geometries[g];
     tg::Mesh mesh;
     mesh.name = geom.name;
     const size_t end = size_t(geom.first_triangle) + geom.triangle_count;
@@ -184,10 +185,15 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
       t = run;
     }
     m.meshes.push_back(mesh);
-    tg::Node node;
-    node.mesh = int(m.meshes.size() - 1);
-    m.nodes.push_back(node);
-    root.nodes.push_back(int(m.nodes.size() - 1));
+    const auto placed = options.placements.find(g);
+    const size_t nodes = placed == options.placements.end() ? 1 : placed->second.size();
+    for (size_t k = 0; k < nodes; ++k) {
+      tg::Node node;
+      node.mesh = int(m.meshes.size() - 1);
+      if (placed != options.placements.end()) node.matrix.assign(placed->second[k].begin(), placed->second[k].end());
+      m.nodes.push_back(node);
+      root.nodes.push_back(int(m.nodes.size() - 1));
+    }
   }
   if (scene.camera) {
     const CameraSpec& c = *scene.camera;

@@ -2,8 +2,10 @@
 // lines of our own), so that an OBJ scene and its conversions can be rendered side by side.
 #pragma once
 
+#include <array>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "scene/scene.hpp"
 
@@ -13,6 +15,9 @@ struct GltfWriteOptions {
   bool binary = false;  // .glb: one file, its buffer inside
   // Per tracer material index: a baseColorTexture image URI (relative to the file's folder).
   std::map<uint32_t, std::string> base_color_images;
+  // Per geometry index: the transforms (column-major 4x4, glTF's node matrix) of the nodes that
+  // place its mesh; a geometry not listed is placed once, untransformed.
+  std::map<uint32_t, std::vector<std::array<double, 16>>> placements;
 };
 
 // Every triangle, one indexed primitive per run of one material within a geometry (corners equal

@@ -221,14 +221,15 @@ TEST(Gltf, HostileFilesFailWithOneLineNamingTheFile) {
     cases.push_back({"a cycle of nodes", g, "t.gltf: node 0 is its own ancestor"});
   }
   {
-    // 40 levels, each naming the next twice: 2^40 instances of the triangle in a few hundred bytes.
+    // 40 levels, each naming the next twice: 2^40 instances of the triangle in a few hundred bytes
+    // (with a memory limit, refused by it first: the reliability table's row).
     TinyGltf g;
     g.node = R"({"mesh": 0, "children": [1, 1]})";
     for (int i = 1; i < 40; ++i)
       g.extra_nodes += ", {\"mesh\": 0, \"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
     g.extra_nodes += R"(, {"mesh": 0})";
     cases.push_back(
-        {"instances that expand without bound", g, "t.gltf: its instances expand to more than 33554432 triangles"});
+        {"instances that expand without bound", g, "t.gltf: its nodes expand to more than 16777216 instances"});
   }
   {
     // The same with no mesh below the root: no triangles to count, but 2^40 nodes to walk.
@@ -378,7 +379,11 @@ TEST(Gltf, InfoCountsEachNodeOnceAndAgreesWithTheLoad) {
   g.node = R"({"children": [1, 1, 2]})";
   g.extra_nodes = R"(, {"mesh": 0, "translation": [2, 0, 0], "children": [2]}, {"mesh": 0, "scale": [1, 3, 1]})";
   std::ofstream(dir + "/i.gltf") << g.json();
-  const Scene s = load_gltf(dir + "/i.gltf");
+  LoadLimits flat;
+  flat.keep_instances = false;
+  const Scene s = load_gltf(dir + "/i.gltf", {}, nullptr, flat);
+  const Scene kept = load_gltf(dir + "/i.gltf");
+  ASSERT_TRUE(kept.instanced());
   const auto info = test::run_tracer("info " + dir + "/i.gltf");
   EXPECT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("triangles   " + std::to_string(s.size()) + " (0 degenerate)"), std::string::npos)
@@ -389,6 +394,10 @@ TEST(Gltf, InfoCountsEachNodeOnceAndAgreesWithTheLoad) {
   std::snprintf(bounds, sizeof bounds, "bounds      (%g, %g, %g) - (%g, %g, %g)", s.bounds.lo.x, s.bounds.lo.y,
                 s.bounds.lo.z, s.bounds.hi.x, s.bounds.hi.y, s.bounds.hi.z);
   EXPECT_NE(info.output.find(bounds), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("placed by 5 instances of 1 meshes holding 1 unique"), std::string::npos) << info.output;
+  EXPECT_EQ(kept.instanced_size(), s.size());
+  EXPECT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept.instances.size(), 5u);
   // 40 levels each naming the next twice: counted, not expanded (a render refuses it).
   TinyGltf huge;
   huge.node = R"({"mesh": 0, "children": [1, 1]})";
@@ -419,13 +428,28 @@ TEST(Gltf, InstancesAboveTheMemoryLimitAreRefusedBeforeExpanding) {
   } catch (const InputError& error) {
     e = error.what();
   }
+  EXPECT_EQ(e.rfind("t.gltf: its 1 unique triangles, 1048576 instances and their accelerator: about 352 MiB needed", 0),
+            0u)
+      << e;
+  EXPECT_NE(e.find("needed, more than the memory limit of 64 MiB (--max-memory-mib"), std::string::npos) << e;
+  // Expanded (for an accelerator that traces no instances): the triangles they expand to.
+  limits.keep_instances = false;
+  try {
+    load_gltf_from_memory(
+        g.json(), "t.gltf", [](const std::string&) {}, limits);
+  } catch (const InputError& error) {
+    e = error.what();
+  }
   EXPECT_EQ(
       e.rfind("t.gltf: the 1048576 triangles its instances expand to and their accelerator: about 216 MiB needed", 0),
       0u)
       << e;
-  EXPECT_NE(e.find("needed, more than the memory limit of 64 MiB (--max-memory-mib"), std::string::npos) << e;
   limits.max_memory = uint64_t(1) << 30;
   EXPECT_EQ(load_gltf_from_memory(g.json(), "t.gltf", {}, limits).size(), 1u << 20);
+  limits.keep_instances = true;
+  const Scene kept = load_gltf_from_memory(g.json(), "t.gltf", {}, limits);
+  EXPECT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept.instances.size(), 1u << 20);
 }
 
 TEST(Gltf, ExternalFilesMustLieInsideTheScenesFolder) {

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "base/errors.hpp"
+#include "base/memory_limit.hpp"
 #include "base/stopwatch.hpp"
 #include "cli/bench.hpp"
 #include "frontend/prepare_render.hpp"
@@ -98,7 +99,12 @@ int cmd_render(const RenderArgs& args) {
 int cmd_info(const SceneArgs& args) {
   const SceneInfo scene = scene_info(args, /*quiet=*/false);
   std::printf("scene       %s\n", scene.source.c_str());
-  std::printf("triangles   %" PRIu64 " (%" PRIu64 " degenerate)\n", scene.triangles, scene.degenerate);
+  std::printf("triangles   %" PRIu64 " (%" PRIu64 " degenerate)", scene.triangles, scene.degenerate);
+  if (scene.instances > 0) {
+    std::printf(", placed by %" PRIu64 " instances of %" PRIu64 " meshes holding %" PRIu64 " unique", scene.instances,
+                scene.meshes, scene.unique_triangles);
+  }
+  std::printf("\n");
   std::printf("vertices    %" PRIu64 "\n", scene.vertices);
   std::printf("geometries  %" PRIu64 "\n", scene.geometries);
   std::printf("materials   %zu:", scene.materials.size());
@@ -121,6 +127,9 @@ int cmd_info(const SceneArgs& args) {
   }
   std::printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", scene.bounds.lo.x, scene.bounds.lo.y, scene.bounds.lo.z,
               scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
+  std::printf(
+      "memory      about %s with bvh8's tree (a render adds its image; --max-memory-mib)\n",
+      scene.estimated_bytes == UINT64_MAX ? "more than 2^62 bytes" : format_bytes(scene.estimated_bytes).c_str());
   return 0;
 }
 

@@ -21,7 +21,9 @@ PreparedRender::PreparedRender(const RenderArgs& args, const PrepareOptions& opt
       build_bytes_per_triangle(planned.kind, args.build_quality ? planned.quality : BuildQuality::High);
   const auto t_load = Clock::now();
   scene = load_scene(args.scene, options.quiet, options.cancel, &load_phases,
-                     {.bytes = memory, .accel_bytes_per_triangle = accel_per_triangle});
+                     {.bytes = memory,
+                      .accel_bytes_per_triangle = accel_per_triangle,
+                      .keep_instances = traces_instances(planned.kind)});
   load_ms = ms_since(t_load);
   if (options.writes_outputs) check_outputs_against_inputs(args);
   camera = camera_for(scene, args);

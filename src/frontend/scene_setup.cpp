@@ -68,6 +68,7 @@ Scene load_scene(const SceneArgs& a, bool quiet, CancelFlag cancel, LoadPhases* 
   LoadLimits limits;
   limits.max_memory = memory.bytes ? memory.bytes : memory_limit(a);
   limits.accel_bytes_per_triangle = memory.accel_bytes_per_triangle;
+  limits.keep_instances = memory.keep_instances;
   limits.max_obj_bytes = uint64_t(a.max_input_mib) << 20;
   limits.textures.max_total_bytes = uint64_t(a.max_texture_mib) << 20;
   // Textures are read and decoded on every thread the render may use.
@@ -177,10 +178,19 @@ SceneInfo scene_info(const SceneArgs& a, bool quiet) {
   // A glTF as the file says (nothing added by flags) is counted without placing its instances.
   const bool as_file = a.view.empty() && a.lights.empty() && !a.no_scene_lights && !a.light_intensity &&
                        a.env_map.empty() && !a.camera && !a.scene.empty() && a.scene != "-";
-  if (!as_file || scene_format(a.scene) != SceneFormat::Gltf) return info_of(load_scene(a, quiet));
+  // The estimate is of the default accelerator's (bvh8, medium quality) over the scene.
+  const uint64_t accel_per_triangle = build_bytes_per_triangle(AccelKind::Bvh8, BuildQuality::Medium);
+  if (!as_file || scene_format(a.scene) != SceneFormat::Gltf) {
+    const Scene scene = load_scene(a, quiet);
+    SceneInfo info = info_of(scene);
+    info.estimated_bytes = scene.memory_bytes() + uint64_t(scene.size()) * accel_per_triangle +
+                           uint64_t(scene.instances.size()) * kBytesPerInstance;
+    return info;
+  }
   check_range("--max-input-mib", a.max_input_mib, 1, 1 << 20);
   LoadLimits limits;
   limits.max_obj_bytes = uint64_t(a.max_input_mib) << 20;
+  limits.accel_bytes_per_triangle = accel_per_triangle;
   const WarningSink silent = [](const std::string&) {};
   return gltf_info(a.scene, quiet ? silent : WarningSink{}, nullptr, limits);
 }

@@ -14,6 +14,7 @@ namespace tracer::frontend {
 struct MemoryBudget {
   uint64_t bytes = 0;
   uint64_t accel_bytes_per_triangle = 0;
+  bool keep_instances = true;  // false: a glTF's instances expanded (LoadLimits::keep_instances)
 };
 
 // Loads the OBJ (or builds the built-in scene) and applies --light / --no-scene-lights.

@@ -18,10 +18,12 @@ inline constexpr uint64_t kSaturated = uint64_t(1) << 62;  // counts stop growin
 // the scene). Saturating at kSaturated.
 struct Placed {
   uint64_t triangles = 0, primitives = 0, nodes = 0;  // nodes: visits of the expansion
+  uint64_t instances = 0;                             // placements of a mesh
   void add(const Placed& o) {
     triangles = std::min(triangles + o.triangles, kSaturated);
     primitives = std::min(primitives + o.primitives, kSaturated);
     nodes = std::min(nodes + o.nodes, kSaturated);
+    instances = std::min(instances + o.instances, kSaturated);
   }
 };
 // A subtree's sums for tracer info, in the frame of its node's parent.

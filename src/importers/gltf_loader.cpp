@@ -31,10 +31,10 @@ using gltf::kSaturated;
 using gltf::Placed;
 using gltf::Summary;
 
-// The most triangles a scene may hold once its instances are expanded: a node tree that reuses a
-// mesh 2^30 times in a few hundred bytes must fail, not exhaust memory (33.5M triangles is about
-// 3.6 GB with their normals and texture coordinates).
-constexpr uint64_t kMaxTriangles = uint64_t(1) << 25;
+// The most triangles a scene may hold (what a triangle index addresses): the unique triangles of an
+// instanced scene, all of them once a flat one's instances are expanded. Memory usually refuses
+// a scene long before (the estimate below).
+constexpr uint64_t kMaxTriangles = UINT32_MAX;
 // Deeper node trees than this are refused (real files nest a few dozen levels).
 constexpr int kMaxNodeDepth = 256;
 // Node instances (a node once for each path that reaches it) the expansion may visit.
@@ -63,23 +63,23 @@ class GltfScene {
     std::vector<uint64_t> subtree(model_.nodes.size(), kUncounted);
     std::vector<Placed> placed(model_.nodes.size());
     Placed all;
-    for (int root : roots) all.add(count_placed(root, subtree, placed, 0));
-    const uint64_t total = all.triangles;
-    const bool normals = any_attribute("NORMAL"), uvs = any_attribute("TEXCOORD_0");
-    const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits_.accel_bytes_per_triangle;
-    constexpr uint64_t kPerPrimitive = sizeof(Geometry) + 32;  // and its name
-    const uint64_t estimate = total >= kSaturated / per_triangle || all.primitives >= kSaturated / kPerPrimitive
-                                  ? UINT64_MAX
-                                  : total * per_triangle + all.primitives * kPerPrimitive;
+    std::set<int> used_meshes;
+    for (int root : roots) all.add(count_placed(root, subtree, placed, used_meshes, 0));
+    const Footprint f = footprint(all, used_meshes);
+    instanced_ = f.instanced;
+    const uint64_t total = f.triangles, primitives = f.primitives, instances = f.instances, estimate = f.bytes;
     if (estimate > limits_.max_memory) {
-      throw InputError(memory_refusal(where("the " + (total >= kSaturated ? "more than 2^62" : std::to_string(total)) +
-                                            " triangles its instances expand to" +
-                                            (limits_.accel_bytes_per_triangle ? " and their accelerator" : "")),
+      const std::string count = total >= kSaturated ? "more than 2^62" : std::to_string(total);
+      const std::string what =
+          instanced_ ? "its " + count + " unique triangles, " +
+                           (instances >= kSaturated ? "more than 2^62" : std::to_string(instances)) + " instances"
+                     : "the " + count + " triangles its instances expand to";
+      throw InputError(memory_refusal(where(what + (limits_.accel_bytes_per_triangle ? " and their accelerator" : "")),
                                       estimate, limits_.max_memory));
     }
     if (total > kMaxTriangles) {
-      throw error("its instances expand to more than " + std::to_string(kMaxTriangles) +
-                  " triangles, more than tracer loads");
+      throw error(std::string(instanced_ ? "its meshes hold" : "its instances expand to") + " more than " +
+                  std::to_string(kMaxTriangles) + " triangles, more than a triangle index addresses");
     }
     // Nodes without meshes cost no memory but a visit each: a tree of them reached along 2^40
     // paths would take hours to walk (found by fuzz_gltf).
@@ -92,9 +92,10 @@ class GltfScene {
     scene_.tri_geom.reserve(total);
     scene_.tri_prim.reserve(total);
     scene_.tri_material.reserve(total);
-    if (normals) scene_.corner_normals.reserve(3 * total);
-    if (uvs) scene_.corner_uvs.reserve(3 * total);
-    scene_.geometries.reserve(all.primitives);
+    if (any_attribute("NORMAL")) scene_.corner_normals.reserve(3 * total);
+    if (any_attribute("TEXCOORD_0")) scene_.corner_uvs.reserve(3 * total);
+    scene_.geometries.reserve(primitives);
+    if (instanced_) scene_.instances.reserve(instances);
     std::vector<char> on_path(model_.nodes.size(), 0);
     for (int root : roots) visit(root, Affine{}, on_path, 0);
     if (scene_.triangles.empty()) throw InputError(name_ + ": scene has no triangles");
@@ -103,6 +104,34 @@ class GltfScene {
     look_at_centre();
     if (!scene_.cameras.empty()) scene_.camera = scene_.cameras.front();
     return std::move(scene_);
+  }
+
+  // What the scene will hold and take: a mesh placed more than once is kept once, with its
+  // placements as instances (unless limits_.keep_instances is false); the estimate is its arrays
+  // and the accelerator's bytes per triangle, saturating at UINT64_MAX.
+  struct Footprint {
+    bool instanced = false;
+    uint64_t triangles = 0, primitives = 0, instances = 0, bytes = 0;
+  };
+  Footprint footprint(const Placed& all, const std::set<int>& used_meshes) const {
+    uint64_t unique = 0, unique_primitives = 0;
+    for (int m : used_meshes) {
+      unique += mesh_triangles(m);
+      unique_primitives += model_.meshes[size_t(m)].primitives.size();
+    }
+    Footprint f;
+    f.instanced = limits_.keep_instances && all.triangles > unique;
+    f.triangles = f.instanced ? unique : all.triangles;
+    f.primitives = f.instanced ? unique_primitives : all.primitives;
+    f.instances = f.instanced ? all.instances : 0;
+    const bool normals = any_attribute("NORMAL"), uvs = any_attribute("TEXCOORD_0");
+    const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits_.accel_bytes_per_triangle;
+    constexpr uint64_t kPerPrimitive = sizeof(Geometry) + 32;  // and its name
+    f.bytes = f.triangles >= kSaturated / per_triangle || f.primitives >= kSaturated / kPerPrimitive ||
+                      f.instances >= kSaturated / kBytesPerInstance
+                  ? UINT64_MAX
+                  : f.triangles * per_triangle + f.primitives * kPerPrimitive + f.instances * kBytesPerInstance;
+    return f;
   }
 
   // What tracer info prints, each node counted once however often it is reached: counts and
@@ -123,6 +152,18 @@ class GltfScene {
     info.degenerate = all.degenerate;
     info.unlisted_area_lights = all.emissive;
     info.bounds = all.box;
+    std::set<int> used_meshes;
+    for (size_t i = 0; i < model_.nodes.size(); ++i) {
+      const int mesh = model_.nodes[i].mesh;
+      if (state[i] != kUncounted && mesh >= 0 && size_t(mesh) < model_.meshes.size()) used_meshes.insert(mesh);
+    }
+    const Footprint f = footprint(all.placed, used_meshes);
+    if (f.instanced) {
+      info.unique_triangles = f.triangles;
+      info.meshes = used_meshes.size();
+      info.instances = f.instances;
+    }
+    info.estimated_bytes = f.bytes;
     if (all.placed.primitives > 0 && uses_default_material()) info.materials.push_back(Material{}.name);
     for (size_t i = 0; i < model_.materials.size(); ++i) {
       info.materials.push_back(model_.materials[i].name.empty() ? "material " + std::to_string(i)
@@ -216,6 +257,7 @@ class GltfScene {
         }
         here.add(gltf::summary_of(*it->second, emissive), Affine{});
       }
+      here.placed.instances = 1;
     }
     here.listed = node.camera >= 0 || gltf::extension(node.extensions, "KHR_lights_punctual");
     for (int child : node.children) {
@@ -303,7 +345,8 @@ class GltfScene {
     return n;
   }
 
-  Placed count_placed(int index, std::vector<uint64_t>& subtree, std::vector<Placed>& placed, int depth) const {
+  Placed count_placed(int index, std::vector<uint64_t>& subtree, std::vector<Placed>& placed, std::set<int>& used,
+                      int depth) const {
     check_node(index, depth);
     uint64_t& state = subtree[size_t(index)];
     if (state == kCounting) throw error("node " + std::to_string(index) + " is its own ancestor");
@@ -315,8 +358,10 @@ class GltfScene {
     if (node.mesh >= 0 && size_t(node.mesh) < model_.meshes.size()) {
       sum.triangles = mesh_triangles(node.mesh);
       sum.primitives = model_.meshes[size_t(node.mesh)].primitives.size();
+      sum.instances = 1;
+      used.insert(node.mesh);
     }
-    for (int child : node.children) sum.add(count_placed(child, subtree, placed, depth + 1));
+    for (int child : node.children) sum.add(count_placed(child, subtree, placed, used, depth + 1));
     state = 0;
     placed[size_t(index)] = sum;
     return sum;
@@ -350,6 +395,7 @@ class GltfScene {
                   std::to_string(model_.meshes.size()) + ")");
     }
     if (node.skin >= 0) warnings_.add("skinned meshes are rendered as bound, unposed");
+    if (instanced_) return add_instance(node.mesh, world);
     const tg::Mesh& m = model_.meshes[size_t(node.mesh)];
     for (size_t k = 0; k < m.primitives.size(); ++k) {
       const tg::Primitive& p = m.primitives[k];
@@ -375,6 +421,58 @@ class GltfScene {
     }
   }
 
+  // Instance mode: glTF mesh `mesh` as one scene mesh (its primitives appended once, in its own
+  // space) and this placement of it.
+  void add_instance(int mesh, const Affine& world) {
+    auto [it, fresh] = scene_meshes_.try_emplace(mesh, kInvalidIndex);
+    if (fresh) it->second = add_scene_mesh(mesh);
+    if (it->second == kInvalidIndex) return;  // no triangles
+    const double det = world.determinant();
+    const Affine inverse = world.inverse();
+    if (det == 0.0 || !inverse.finite()) {
+      warnings_.add("instances with a singular transform (a zero scale) place nothing: not rendered");
+      return;
+    }
+    const Aabb& box = object_boxes_[it->second];
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 v =
+          world.point({(k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z});
+      if (!is_finite(v) || std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kMaxCoordinate) {
+        throw error(primitive_name(mesh, 0) + ": its node's transform moves a vertex beyond +-" +
+                    std::string(kMaxCoordinateText));
+      }
+    }
+    scene_.instances.push_back(make_instance(it->second, world));
+  }
+
+  // Appends glTF mesh `mesh`'s primitives untransformed as one scene mesh; returns its index, or
+  // kInvalidIndex when it has no triangles.
+  uint32_t add_scene_mesh(int mesh) {
+    const tg::Mesh& m = model_.meshes[size_t(mesh)];
+    const auto first = uint32_t(scene_.triangles.size());
+    Aabb box;
+    for (size_t k = 0; k < m.primitives.size(); ++k) {
+      const tg::Primitive& p = m.primitives[k];
+      const std::string what = primitive_name(mesh, k);
+      auto [it, fresh] = meshes_.try_emplace({mesh, int(k)});
+      if (fresh) it->second = gltf::primitive_mesh(model_, name_, warnings_, p, what);
+      if (!it->second) continue;
+      for (const Vec3& v : it->second->positions) {
+        if (!is_finite(v) || std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kMaxCoordinate) {
+          throw error(what + ": a vertex lies beyond +-" + std::string(kMaxCoordinateText));
+        }
+        box.extend(v);
+      }
+      append_mesh(scene_, m.name.empty() ? what : m.name, *it->second, materials_.material(p.material, scene_));
+      it->second.reset();  // placed once: its arrays are the scene's now
+    }
+    const auto count = uint32_t(scene_.triangles.size() - first);
+    if (count == 0) return kInvalidIndex;
+    scene_.meshes.push_back({m.name.empty() ? "mesh " + std::to_string(mesh) : m.name, {first, count}, {}});
+    object_boxes_.push_back(box);
+    return uint32_t(scene_.meshes.size() - 1);
+  }
+
   void add_camera(int index, const Affine& world) {
     if (std::optional<CameraSpec> c = gltf::camera_of(model_, name_, warnings_, index, world))
       scene_.cameras.push_back(*c);
@@ -393,6 +491,9 @@ class GltfScene {
   WarningLog& warnings_;
   Scene scene_;
   std::map<std::pair<int, int>, std::optional<IndexedMesh>> meshes_;  // (mesh, primitive)
+  bool instanced_ = false;                                            // meshes kept once, placed by instances
+  std::map<int, uint32_t> scene_meshes_;                              // glTF mesh -> Scene::meshes index
+  std::vector<Aabb> object_boxes_;                                    // per scene mesh, of its vertices
   gltf::Materials materials_;
 };
 

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "base/read_input.hpp"
+#include "scene/instances.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -16,6 +17,10 @@ using ForEach = std::function<void(size_t count, const std::function<void(size_t
 inline void sequential_for_each(size_t count, const std::function<void(size_t)>& body) {
   for (size_t i = 0; i < count; ++i) body(i);
 }
+
+// What an instance takes at the peak of a render's build: the Instance, and the top-level tree's
+// share (its box, the builder's reference and scratch node share, the tree's node share).
+inline constexpr uint64_t kBytesPerInstance = sizeof(Instance) + 24 + 32 + 128 + 40;
 
 // What a load may read (the scene file's size, MTL files 64 MiB each, the textures' texels), and
 // the loop it reads and decodes textures with.
@@ -30,6 +35,10 @@ struct LoadLimits {
   // estimate, its arrays plus accel_bytes_per_triangle for each triangle, is above max_memory.
   uint64_t max_memory = UINT64_MAX;
   uint64_t accel_bytes_per_triangle = 0;  // 0: no accelerator follows (tracer info)
+  // A glTF that places a mesh more than once keeps it once, placed by instances (Scene::instances);
+  // false: every placement is expanded into world-space triangles (for the accelerators that
+  // trace no instances).
+  bool keep_instances = true;
 };
 
 // Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its
