@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -165,7 +166,9 @@ TEST_F(TwoLevel, HitsAgreeWithTheFlattenedScene) {
 #ifdef TRACER_HAVE_EMBREE
     Hit c;
     ASSERT_EQ(embree.intersect(ray, c), hb);
-    if (hb) EXPECT_EQ(c.tri, b.tri);
+    if (hb) {
+      EXPECT_EQ(c.tri, b.tri);
+    }
 #endif
     if (!ha) {
       EXPECT_FALSE(tree.occluded(ray));
@@ -184,6 +187,33 @@ TEST_F(TwoLevel, HitsAgreeWithTheFlattenedScene) {
     EXPECT_EQ(tree.occluded(shorter), wide.occluded(shorter));
   }
   EXPECT_GT(hits, test::ray_budget(20000) / 10);
+}
+
+// An AO bundle (up to 16 rays from one point) gets, lane by lane, the answer occluded() gives
+// each of its rays, the top level and each instance's mesh searched with the bundle's open rays.
+TEST_F(TwoLevel, BundlesAnswerAsSingleRays) {
+  const Scene kept = load(path_, true);
+  const TwoLevelBvh tree(kept, BvhBuildOptions{});
+  const std::vector<Ray> rays = test::random_rays(kept, test::ray_budget(20000), 11);
+  size_t occluded = 0;
+  for (size_t i = 0; i + 16 <= rays.size(); i += 16) {
+    RayBundle bundle;
+    bundle.org = rays[i].org;
+    bundle.tfar = i % 32 == 0 ? kInfinity : 2.0f;
+    for (int k = 0; k < 16; ++k) {
+      if ((i / 16 + size_t(k)) % 5 != 0) bundle.set_direction(k, rays[i + size_t(k)].dir);
+    }
+    TraversalCounts counts;
+    const uint32_t bits = tree.occluded_bundle_from(bundle, 0), counted = tree.occluded_bundle_from(bundle, 0, counts);
+    EXPECT_EQ(bits, counted);
+    EXPECT_EQ(counts.rays, uint64_t(std::popcount(bundle.active)));
+    for (int k = 0; k < 16; ++k) {
+      const bool expected = (bundle.active >> k & 1) && tree.occluded(bundle.ray(k));
+      ASSERT_EQ(bool(bits >> k & 1), expected) << "bundle " << i / 16 << " lane " << k;
+      occluded += expected ? 1 : 0;
+    }
+  }
+  EXPECT_GT(occluded, rays.size() / 10);
 }
 
 // --count counts the top level's nodes and, below each instance entered, its mesh tree's: one
@@ -288,7 +318,9 @@ TEST(TwoLevelScale, TenThousandBunniesFitInAGibibyte) {
   const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir + "/s.json"));
   EXPECT_EQ(stats["triangles"].get<uint64_t>(), bunny.size());
   EXPECT_GT(stats["rays"]["primary"].get<uint64_t>(), 0u);
-  if (!test::kUnderSanitizer) EXPECT_LT(stats["peak_rss_mib"].get<double>(), 1024.0);
+  if (!test::kUnderSanitizer) {
+    EXPECT_LT(stats["peak_rss_mib"].get<double>(), 1024.0);
+  }
   const auto info = test::run_tracer("info " + path);
   EXPECT_NE(info.output.find("(0 degenerate), placed by 10000 instances of 1 meshes"), std::string::npos)
       << info.output;

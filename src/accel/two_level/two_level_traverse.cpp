@@ -6,7 +6,10 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include <bit>
+
 #include "accel/two_level/two_level_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_bundle_kernels-inl.h"
 #include "accel/wide_bvh/wide_bvh_kernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -91,6 +94,63 @@ bool OccludedTwoLevelT(const TwoLevelBvh& tl, const Ray& ray, Count count) {
   }
 }
 
+// The AO rays of one point (a bundle): the top level's boxes tested against all of its rays still
+// open, and at each instance the bundle moved into the mesh's space (its origin and each
+// direction) and searched there by the flat tree's bundle kernel.
+template <class Count>
+uint32_t OccludedBundleTwoLevelT(const TwoLevelBvh& tl, const RayBundle& rays, Count count) {
+  count.rays(uint32_t(std::popcount(rays.active)));
+  const WideNodeArray& nodes = tl.top_nodes();
+  if (nodes.empty() || rays.active == 0) return 0;
+  const std::span<const Instance> instances = tl.instances();
+  const BundleState st(rays);
+  uint32_t active = rays.active, occluded = 0;
+  struct Entry {
+    uint32_t child, count, lanes;
+  };
+  Entry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  int sp = 0;
+  stack[sp++] = {0, 0, active};
+  while (sp > 0) {
+    const Entry e = stack[--sp];
+    const uint32_t lanes = e.lanes & active;
+    if (lanes == 0) continue;
+    uint32_t found = 0;
+    if (e.count > 0) {
+      const Instance& in = instances[e.child];
+      RayBundle local;
+      local.org = in.to_object.point(rays.org);
+      local.tnear = rays.tnear;
+      local.tfar = rays.tfar;
+      for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        local.set_direction(k, in.to_object.vector({rays.dx[k], rays.dy[k], rays.dz[k]}));
+      }
+      found = OccludedBundleInTree(tl.mesh_tree(in.mesh), BundleState(local), lanes, count);
+    } else {
+      count.node(uint32_t(std::popcount(lanes)));
+      const WideNode& n = nodes[e.child];
+      for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
+        if (n.child[c] == 0 && n.count[c] == 0) break;  // empty slots come last
+        const float clo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, chi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
+        const uint32_t entering = TestBundleBox(clo, chi, st, lanes);
+        if (entering) stack[sp++] = {n.child[c], n.count[c], entering};
+      }
+    }
+    occluded |= found;
+    active &= ~found;
+    if (active == 0) break;
+  }
+  return occluded;
+}
+
+uint32_t OccludedBundleTwoLevel(const TwoLevelBvh& tl, const RayBundle& rays) {
+  return OccludedBundleTwoLevelT(tl, rays, NoCount{});
+}
+uint32_t OccludedBundleTwoLevelCounted(const TwoLevelBvh& tl, const RayBundle& rays, TraversalCounts* counts) {
+  return OccludedBundleTwoLevelT(tl, rays, CountInto{counts});
+}
+
 bool IntersectTwoLevel(const TwoLevelBvh& tl, const Ray& ray, Hit& hit) {
   return IntersectTwoLevelT(tl, ray, hit, NoCount{});
 }
@@ -113,6 +173,8 @@ HWY_EXPORT(IntersectTwoLevel);
 HWY_EXPORT(IntersectTwoLevelCounted);
 HWY_EXPORT(OccludedTwoLevel);
 HWY_EXPORT(OccludedTwoLevelCounted);
+HWY_EXPORT(OccludedBundleTwoLevel);
+HWY_EXPORT(OccludedBundleTwoLevelCounted);
 
 bool TwoLevelBvh::intersect(const Ray& ray, Hit& hit) const {
   return SIMD_DISPATCH(simd_, IntersectTwoLevel)(*this, ray, hit);
@@ -123,6 +185,13 @@ bool TwoLevelBvh::intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) c
 }
 bool TwoLevelBvh::occluded(const Ray& ray, TraversalCounts& counts) const {
   return SIMD_DISPATCH(simd_, OccludedTwoLevelCounted)(*this, ray, &counts);
+}
+
+uint32_t TwoLevelBvh::occluded_bundle_from(const RayBundle& rays, uint32_t /*origin*/) const {
+  return SIMD_DISPATCH(simd_, OccludedBundleTwoLevel)(*this, rays);
+}
+uint32_t TwoLevelBvh::occluded_bundle_from(const RayBundle& rays, uint32_t /*origin*/, TraversalCounts& counts) const {
+  return SIMD_DISPATCH(simd_, OccludedBundleTwoLevelCounted)(*this, rays, &counts);
 }
 
 }  // namespace tracer
