@@ -20,6 +20,7 @@
 #include <tuple>
 
 #include "io/exr_io.hpp"
+#include "scene_writers.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -222,6 +223,31 @@ TEST_F(MpiRender, DifferentSceneContentsAreDetectedBeforeRendering) {
   EXPECT_NE(m.output.find("rank 1 loaded different scene contents than rank 0"), std::string::npos) << m.output;
   EXPECT_EQ(own_lines(m.output), 1) << m.output;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// An instanced glTF (one mesh placed twice: a two-level tree on every rank) renders as in one
+// process; the instances' transforms join the scene checksum.
+TEST_F(MpiRender, InstancedScenesAreTheSameOnEveryRankAndChecked) {
+  const Scene s = test::scene_of({{{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}}, {{-1, -1, -1}, {0, 1, -1}, {1, -1, -1}}});
+  test::GltfWriteOptions options;
+  options.placements[0] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1},
+                           {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 1}};
+  test::write_gltf(s, dir_ + "/a.gltf", options);
+  options.placements[0][1][13] = 0.25;  // the second placement raised
+  test::write_gltf(s, dir_ + "/b.gltf", options);
+  const std::string common = " --integrator ao --ao 4 --width 40 --height 30 -q --exr float";
+  const auto r = test::run_tracer("render " + dir_ + "/a.gltf" + common + " -o " + dir_ + "/ref.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto m =
+      run(mpirun(2) + kMpiExe + " render " + dir_ + "/a.gltf" + common + " --tile 7 -o " + dir_ + "/mpi.exr");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_TRUE(same_bytes(read_file(dir_ + "/mpi.exr"), read_file(dir_ + "/ref.exr")));
+  const std::string out = dir_ + "/x.exr";
+  const auto d =
+      run(std::string(kMpirun) + " --allow-run-as-root --oversubscribe -np 1 " + kMpiExe + " render " + dir_ +
+          "/a.gltf -q -o " + out + " : -np 1 " + kMpiExe + " render " + dir_ + "/b.gltf -q -o " + out);
+  EXPECT_EQ(d.exit_code, 1) << d.output;
+  EXPECT_NE(d.output.find("rank 1 loaded different scene contents than rank 0"), std::string::npos) << d.output;
 }
 
 TEST_F(MpiRender, BadUsageIsOneErrorAndExitTwo) {

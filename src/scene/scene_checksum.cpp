@@ -66,6 +66,15 @@ uint64_t scene_checksum(const Scene& scene) {
     for (const Vec3& c : {l.position, l.normal, l.power}) h.value(c);
     h.value(l.area);
   }
+  if (scene.instanced()) {  // flat scenes keep the checksums they had
+    h.value(uint64_t(scene.meshes.size()));
+    for (const Mesh& m : scene.meshes) h.value(m.triangles);
+    h.value(uint64_t(scene.instances.size()));
+    for (const Instance& in : scene.instances) {
+      h.value(in.mesh);
+      h.value(in.to_world.m);
+    }
+  }
   return h.get();
 }
 
