@@ -45,6 +45,14 @@ gltf '[{"mesh":0}]' 3 "$data" | sed 's/"primitives":\[{/"primitives":[{"material
 nodes='[{"children":[1,1]}'
 for i in $(seq 1 23); do nodes+=",{\"children\":[$((i + 1)),$((i + 1))]}"; done
 gltf "$nodes"',{"mesh":0}]' 3 "$data" > inst24.gltf
+# Instances kept as instances (a mesh placed more than once): 2^16 of one triangle, one of zero
+# scale, one past float's range, one of a mesh that does not exist.
+nodes='[{"children":[1,1]}'
+for i in $(seq 1 15); do nodes+=",{\"children\":[$((i + 1)),$((i + 1))]}"; done
+gltf "$nodes"',{"mesh":0,"translation":[0.1,0,0]}]' 3 "$data" > inst16.gltf
+gltf '[{"mesh":0,"children":[1]},{"mesh":0,"scale":[0,0,0]}]' 3 "$data" > zeroscale.gltf
+gltf '[{"mesh":0,"scale":[1e300,1,1],"children":[1]},{"mesh":0,"scale":[1e300,1,1]}]' 3 "$data" > infscale.gltf
+gltf '[{"mesh":0,"children":[1]},{"mesh":7}]' 3 "$data" > nomesh.gltf
 ln -s "$shared_scenes" shared-scenes  # ../shared/scenes, the same name on every machine
 printf 'glTF\001\000\000\000\024\000\000\000\000\000\000\000JSON' > v1.glb
 : > empty.gltf
@@ -282,6 +290,10 @@ cases=(
   "glTF: an empty file|tracer render empty.gltf -q|1"
   "glTF: 2^24 instances past --max-memory-mib 1024|tracer render inst24.gltf -q --max-memory-mib 1024|1"
   "glTF: tracer info of 2^24 instances (each node counted once)|tracer info inst24.gltf > /dev/null|0"
+  "glTF: 2^16 instances of a triangle (a two-level tree)|tracer render inst16.gltf -q --width 32 --height 32 -o i.png|0"
+  "glTF: an instance of zero scale beside one of scale 1|tracer render zeroscale.gltf --width 16 --height 16 -o z.png|0"
+  "glTF: instances whose scales multiply past float's range|tracer render infscale.gltf -q|1"
+  "glTF: an instance of a mesh that does not exist|tracer render nomesh.gltf -q|1"
   "PLY: an extra value on a row|tracer render extra.ply -q|1"
   "PLY: a property declared twice|tracer render twice.ply -q|1"
   "PLY: an empty file|tracer render empty.ply -q|1"
