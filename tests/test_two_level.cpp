@@ -155,7 +155,7 @@ TEST_F(TwoLevel, HitsAgreeWithTheFlattenedScene) {
   ASSERT_TRUE(two.instanced());
   const WideBvh wide(flat, BvhBuildOptions{});
 #ifdef TRACER_HAVE_EMBREE
-  const EmbreeAccel embree(flat);
+  const EmbreeAccel embree(flat), embree_two(kept);  // Embree's instance geometry
 #endif
   const TwoLevelBvh& tree = std::get<TwoLevelBvh>(*two.impl);
   size_t hits = 0;
@@ -164,10 +164,15 @@ TEST_F(TwoLevel, HitsAgreeWithTheFlattenedScene) {
     const bool ha = tree.intersect(ray, a), hb = wide.intersect(ray, b);
     ASSERT_EQ(ha, hb) << "ray " << hits;
 #ifdef TRACER_HAVE_EMBREE
-    Hit c;
+    Hit c, d;
     ASSERT_EQ(embree.intersect(ray, c), hb);
+    ASSERT_EQ(embree_two.intersect(ray, d), hb);
     if (hb) {
       EXPECT_EQ(c.tri, b.tri);
+      EXPECT_EQ(d.tri, a.tri);
+      EXPECT_EQ(d.inst, a.inst);
+      EXPECT_EQ(d.geomID, a.geomID);
+      EXPECT_NEAR(d.t, a.t, 1e-4f * (1.0f + a.t));
     }
 #endif
     if (!ha) {

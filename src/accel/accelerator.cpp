@@ -33,12 +33,13 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
   Accelerator acc;
   acc.kind = options.kind;
   const auto start = std::chrono::steady_clock::now();
-  if (scene.instanced()) {
+  acc.instanced_scene = scene.instanced();
+  if (scene.instanced() && !is_embree(options.kind)) {
     if (!traces_instances(options.kind)) {
-      throw UsageError(
-          std::string("--accel ") + std::string(name_of<AccelKind>(kAccelKindNames, options.kind)) + ": " +
-          scene.source +
-          " places meshes by instances, which only bvh8 traces (load it for this accelerator to expand them)");
+      throw UsageError(std::string("--accel ") + std::string(name_of<AccelKind>(kAccelKindNames, options.kind)) + ": " +
+                       scene.source +
+                       " places meshes by instances, which only bvh8 and embree trace (load it for this accelerator to "
+                       "expand them)");
     }
     BvhBuildOptions bvh = options.bvh;
     const bool high = options.quality == BuildQuality::High;
@@ -83,6 +84,7 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
 #endif
     }
   }
+  if (acc.instanced_scene) acc.name += "-two-level";  // Embree's instance geometry
   acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return acc;
 }

@@ -90,7 +90,8 @@ struct Accelerator {
   }
   size_t memory_bytes() const;
   // The two-level tree of an instanced scene.
-  bool instanced() const { return std::holds_alternative<TwoLevelBvh>(*impl); }
+  bool instanced() const { return instanced_scene; }
+  bool instanced_scene = false;
   // The binary BVH's shape (nodes, leaves, depth, SAH cost); empty for the other accelerators.
   std::optional<BvhStats> bvh_stats() const;
 };
@@ -105,7 +106,7 @@ inline bool traces_rays_together(AccelKind kind) {
 
 // Whether `kind` traces an instanced scene as instances (a two-level tree); a scene loaded for
 // the others has its instances expanded.
-inline bool traces_instances(AccelKind kind) { return kind == AccelKind::Bvh8; }
+inline bool traces_instances(AccelKind kind) { return kind == AccelKind::Bvh8 || is_embree(kind); }
 
 // Builds the accelerator `options` asks for, timing the build: for an instanced scene, its
 // two-level form (bvh8; the others throw UsageError naming the ones that trace instances). Throws

@@ -24,26 +24,34 @@ EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel, const char* devi
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::monitor, this);
   rtc_scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_scene_, quality);
-  // One Embree geometry per scene geometry, attached in order, so geomID and primID coincide.
-  for (const Geometry& g : scene.geometries) {
-    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), 3 * size_t(g.triangle_count)));
-    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(unsigned), g.triangle_count));
-    for (uint32_t i = 0; i < g.triangle_count; ++i) {
-      const Triangle& t = scene.triangles[g.first_triangle + i];
-      const Vec3 p[3] = {t.v0, t.v1, t.v2};
-      for (int k = 0; k < 3; ++k) {
-        v[9 * i + 3 * k] = p[k].x;
-        v[9 * i + 3 * k + 1] = p[k].y;
-        v[9 * i + 3 * k + 2] = p[k].z;
-        idx[3 * i + k] = 3 * i + unsigned(k);
+  if (!scene.instanced()) {
+    // One Embree geometry per scene geometry, attached in order, so geomID and primID coincide.
+    add_geometries(rtc_scene_, 0, uint32_t(scene.geometries.size()));
+  } else {
+    // Embree's two levels: a scene per mesh (its geometries in order, geomID counted from the
+    // mesh's first) and an instance geometry per instance, attached in order (instID is ours).
+    for (const Mesh& m : scene.meshes) {
+      const uint32_t first = m.triangles.count ? scene.tri_geom[m.triangles.first] : 0;
+      uint32_t end = first;
+      while (end < scene.geometries.size() &&
+             scene.geometries[end].first_triangle < m.triangles.first + m.triangles.count) {
+        ++end;
       }
+      RTCScene mesh_scene = rtcNewScene(device_);
+      rtcSetSceneBuildQuality(mesh_scene, quality);
+      add_geometries(mesh_scene, first, end);
+      rtcCommitScene(mesh_scene);
+      mesh_scenes_.push_back(mesh_scene);
+      first_geometry_.push_back(first);
     }
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(rtc_scene_, geom);
-    rtcReleaseGeometry(geom);
+    for (const Instance& in : scene.instances) {
+      RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, mesh_scenes_[in.mesh]);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &in.to_world.m[0][0]);
+      rtcCommitGeometry(geom);
+      rtcAttachGeometry(rtc_scene_, geom);
+      rtcReleaseGeometry(geom);
+    }
   }
   // Embree asks this during the build; false cancels it (a Ctrl-C during a long build).
   rtcSetSceneProgressMonitorFunction(
@@ -54,13 +62,49 @@ EmbreeAccel::EmbreeAccel(const Scene& scene, CancelFlag cancel, const char* devi
   if (cancelled || failed) {
     // The destructor does not run for a throwing constructor.
     rtcReleaseScene(rtc_scene_);
+    for (RTCScene m : mesh_scenes_) rtcReleaseScene(m);
     rtcReleaseDevice(device_);
     if (cancelled) throw Cancelled();
     throw InputError("embree: scene build failed");
   }
 }
 
+void EmbreeAccel::add_geometries(RTCScene target, uint32_t first, uint32_t end) {
+  for (uint32_t id = first; id < end; ++id) {
+    const Geometry& g = scene_->geometries[id];
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), 3 * size_t(g.triangle_count)));
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), g.triangle_count));
+    for (uint32_t i = 0; i < g.triangle_count; ++i) {
+      const Triangle& t = scene_->triangles[g.first_triangle + i];
+      const Vec3 p[3] = {t.v0, t.v1, t.v2};
+      for (int k = 0; k < 3; ++k) {
+        v[9 * i + 3 * k] = p[k].x;
+        v[9 * i + 3 * k + 1] = p[k].y;
+        v[9 * i + 3 * k + 2] = p[k].z;
+        idx[3 * i + k] = 3 * i + unsigned(k);
+      }
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(target, geom);
+    rtcReleaseGeometry(geom);
+  }
+}
+
+void EmbreeAccel::name_hit(uint32_t geom, uint32_t prim, uint32_t inst, Hit& hit) const {
+  if (inst != RTC_INVALID_GEOMETRY_ID && !first_geometry_.empty()) {
+    hit.inst = inst;
+    geom += first_geometry_[scene_->instances[inst].mesh];
+  }
+  hit.geomID = geom;
+  hit.primID = prim;
+  hit.tri = scene_->geometries[geom].first_triangle + prim;
+}
+
 EmbreeAccel::~EmbreeAccel() {
+  for (RTCScene m : mesh_scenes_) rtcReleaseScene(m);
   if (rtc_scene_) rtcReleaseScene(rtc_scene_);
   if (device_) rtcReleaseDevice(device_);
 }
@@ -90,9 +134,7 @@ bool EmbreeAccel::intersect(const Ray& ray, Hit& hit) const {
   hit.t = rh.ray.tfar;
   hit.u = rh.hit.u;
   hit.v = rh.hit.v;
-  hit.geomID = rh.hit.geomID;
-  hit.primID = rh.hit.primID;
-  hit.tri = scene_->geometries[rh.hit.geomID].first_triangle + rh.hit.primID;
+  name_hit(rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], hit);
   return true;
 }
 
@@ -204,9 +246,7 @@ void EmbreeAccel::intersect_packet(const RayPacket& rays, Hit* hits) const {
     hits[k].t = rh.ray.tfar[k];
     hits[k].u = rh.hit.u[k];
     hits[k].v = rh.hit.v[k];
-    hits[k].geomID = rh.hit.geomID[k];
-    hits[k].primID = rh.hit.primID[k];
-    hits[k].tri = scene_->geometries[rh.hit.geomID[k]].first_triangle + rh.hit.primID[k];
+    name_hit(rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], hits[k]);
   }
 }
 

@@ -7,6 +7,7 @@
 #include <embree3/rtcore.h>
 
 #include <atomic>
+#include <vector>
 
 #include "base/errors.hpp"
 #include "math/ray.hpp"
@@ -35,10 +36,17 @@ class EmbreeAccel {
 
  private:
   static bool monitor(void* user, ssize_t bytes, bool post);
+  // Attaches the scene's geometries [first, end) to `target` in order, one Embree geometry each.
+  void add_geometries(RTCScene target, uint32_t first, uint32_t end);
+  // Fills hit's names from Embree's geomID, primID and instID (an instanced scene's geomID counts
+  // from its mesh's first geometry).
+  void name_hit(uint32_t geom, uint32_t prim, uint32_t inst, Hit& hit) const;
 
   const Scene* scene_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;
+  std::vector<RTCScene> mesh_scenes_;     // an instanced scene's meshes
+  std::vector<uint32_t> first_geometry_;  // per mesh, its first geometry's index
   std::atomic<int64_t> bytes_{0}, peak_bytes_{0};
 };
 
