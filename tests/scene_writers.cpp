@@ -189,6 +189,7 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
     const size_t nodes = placed == options.placements.end() ? 1 : placed->second.size();
     for (size_t k = 0; k < nodes; ++k) {
       tg::Node node;
+      if (options.distinct_meshes && k > 0) m.meshes.push_back(m.meshes.back());
       node.mesh = int(m.meshes.size() - 1);
       if (placed != options.placements.end()) node.matrix.assign(placed->second[k].begin(), placed->second[k].end());
       m.nodes.push_back(node);

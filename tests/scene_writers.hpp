@@ -18,6 +18,9 @@ struct GltfWriteOptions {
   // Per geometry index: the transforms (column-major 4x4, glTF's node matrix) of the nodes that
   // place its mesh; a geometry not listed is placed once, untransformed.
   std::map<uint32_t, std::vector<std::array<double, 16>>> placements;
+  // Each placement a mesh of its own (sharing the first's accessors): a file tracer loads flat,
+  // the same triangles as the instanced one.
+  bool distinct_meshes = false;
 };
 
 // Every triangle, one indexed primitive per run of one material within a geometry (corners equal
