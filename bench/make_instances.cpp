@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   std::vector<std::array<double, 16>> placements;
   for (long k = 0; k < n; ++k) {
     const double a = 0.37 * double(k % side + 3 * (k / side)), c = std::cos(a), s = std::sin(a);
-    placements.push_back({c, 0, -s, 0, 0, 1, 0, 0, s, 0, c, 0, double(k % side) * step, 0, -double(k / side) * step, 1});
+    placements.push_back(
+        {c, 0, -s, 0, 0, 1, 0, 0, s, 0, c, 0, double(k % side) * step, 0, -double(k / side) * step, 1});
   }
   for (uint32_t g = 0; g < scene.geometries.size(); ++g) options.placements[g] = placements;
   test::write_gltf(scene, argv[3], options);
