@@ -33,65 +33,32 @@ bool IntersectTwoLevelT(const TwoLevelBvh& tl, const Ray& ray, Hit& hit, Count c
   count.rays(1);
   hit = Hit{};
   hit.t = ray.tfar;
-  const WideNodeArray& nodes = tl.top_nodes();
-  if (nodes.empty()) return false;
+  if (tl.top_nodes().empty()) return false;
   const std::span<const Instance> instances = tl.instances();
-  const NodeRay wr{WideRay(ray)};
-  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
-  int sp = 0;
-  HWY_ALIGN float t[kWideWidth];
-  StackEntry cur{0, 0, ray.tnear};
-  for (;;) {
-    if (cur.count == 0) {
-      count.node(1);
-      const WideNode& n = nodes[cur.child];
-      if (Descend(n, TestChildren(n, wr, ray.tnear, hit.t, t), t, stack, sp, cur)) continue;
-    } else {
-      const Instance& in = instances[cur.child];
-      const float t_before = hit.t;
-      const uint32_t tri_before = hit.tri;
-      ClosestInTree(tl.mesh_tree(in.mesh), ToObject(in, ray, hit.t), hit, count);
-      if (hit.t != t_before || hit.tri != tri_before) hit.inst = cur.child;
-    }
-    do {
-      if (sp == 0) return finish_hit(tl.scene(), hit);
-      cur = stack[--sp];
-    } while (!(cur.t <= hit.t * SlabGuards::kTieGuard));
-  }
+  ClosestWalk(tl.top_nodes().data(), ray, hit, count, [&](const StackEntry& e) TRACER_INLINE_LAMBDA {
+    const Instance& in = instances[e.child];
+    const float t_before = hit.t;
+    const uint32_t tri_before = hit.tri;
+    ClosestInTree(tl.mesh_tree(in.mesh), ToObject(in, ray, hit.t), hit, count);
+    if (hit.t != t_before || hit.tri != tri_before) hit.inst = e.child;
+  });
+  return finish_hit(tl.scene(), hit);
 }
 
 template <class Count>
 bool OccludedTwoLevelT(const TwoLevelBvh& tl, const Ray& ray, Count count) {
   count.rays(1);
-  const WideNodeArray& nodes = tl.top_nodes();
-  if (nodes.empty()) return false;
+  if (tl.top_nodes().empty()) return false;
   const std::span<const Instance> instances = tl.instances();
-  const NodeRay wr{WideRay(ray)};
-  StackEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
-  int sp = 0;
-  HWY_ALIGN float t[kWideWidth];
-  StackEntry cur{0, 0, ray.tnear};
-  for (;;) {
-    if (cur.count == 0) {
-      count.node(1);
-      const WideNode& n = nodes[cur.child];
-      // Any hit ends the query: the children in slot order, no sort.
-      for (uint32_t bits = TestChildren(n, wr, ray.tnear, ray.tfar, t); bits; bits &= bits - 1) {
-        const int c = __builtin_ctz(bits);
-        stack[sp++] = {n.child[c], n.count[c], 0.0f};
-      }
-    } else {
-      const Instance& in = instances[cur.child];
-      const WideBvh& mesh = tl.mesh_tree(in.mesh);
-      const Ray local = ToObject(in, ray, ray.tfar);
-      if (OccludedBelow(mesh, WideRay(local), RayShear(local), local.tnear, local.tfar, StackEntry{0, 0, local.tnear},
-                        count)) {
-        return true;
-      }
-    }
-    if (sp == 0) return false;
-    cur = stack[--sp];
-  }
+  return AnyHitWalk(tl.top_nodes().data(), NodeRay(WideRay(ray)), ray.tnear, ray.tfar, StackEntry{0, 0, ray.tnear},
+                    count, [&](const StackEntry& e) TRACER_INLINE_LAMBDA {
+                      const Instance& in = instances[e.child];
+                      const WideBvh& mesh = tl.mesh_tree(in.mesh);
+                      if (mesh.nodes().empty()) return false;
+                      const Ray local = ToObject(in, ray, ray.tfar);
+                      return OccludedBelow(mesh, WideRay(local), RayShear(local), local.tnear, local.tfar,
+                                           StackEntry{0, 0, local.tnear}, count);
+                    });
 }
 
 // The AO rays of one point (a bundle): the top level's boxes tested against all of its rays still
@@ -103,45 +70,21 @@ uint32_t OccludedBundleTwoLevelT(const TwoLevelBvh& tl, const RayBundle& rays, C
   const WideNodeArray& nodes = tl.top_nodes();
   if (nodes.empty() || rays.active == 0) return 0;
   const std::span<const Instance> instances = tl.instances();
-  const BundleState st(rays);
-  uint32_t active = rays.active, occluded = 0;
-  struct Entry {
-    uint32_t child, count, lanes;
-  };
-  Entry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
-  int sp = 0;
-  stack[sp++] = {0, 0, active};
-  while (sp > 0) {
-    const Entry e = stack[--sp];
-    const uint32_t lanes = e.lanes & active;
-    if (lanes == 0) continue;
-    uint32_t found = 0;
-    if (e.count > 0) {
-      const Instance& in = instances[e.child];
-      RayBundle local;
-      local.org = in.to_object.point(rays.org);
-      local.tnear = rays.tnear;
-      local.tfar = rays.tfar;
-      for (uint32_t bits = lanes; bits; bits &= bits - 1) {
-        const int k = __builtin_ctz(bits);
-        local.set_direction(k, in.to_object.vector({rays.dx[k], rays.dy[k], rays.dz[k]}));
-      }
-      found = OccludedBundleInTree(tl.mesh_tree(in.mesh), BundleState(local), lanes, count);
-    } else {
-      count.node(uint32_t(std::popcount(lanes)));
-      const WideNode& n = nodes[e.child];
-      for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
-        if (n.child[c] == 0 && n.count[c] == 0) break;  // empty slots come last
-        const float clo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, chi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
-        const uint32_t entering = TestBundleBox(clo, chi, st, lanes);
-        if (entering) stack[sp++] = {n.child[c], n.count[c], entering};
-      }
-    }
-    occluded |= found;
-    active &= ~found;
-    if (active == 0) break;
-  }
-  return occluded;
+  return BundleWalk(nodes.data(), BundleState(rays), rays.active, count,
+                    [&](const BundleEntry& e, uint32_t lanes, uint32_t& found) TRACER_INLINE_LAMBDA {
+                      if (e.count == 0) return false;
+                      const Instance& in = instances[e.child];
+                      RayBundle local;
+                      local.org = in.to_object.point(rays.org);
+                      local.tnear = rays.tnear;
+                      local.tfar = rays.tfar;
+                      for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+                        const int k = __builtin_ctz(bits);
+                        local.set_direction(k, in.to_object.vector({rays.dx[k], rays.dy[k], rays.dz[k]}));
+                      }
+                      found = OccludedBundleInTree(tl.mesh_tree(in.mesh), BundleState(local), lanes, count);
+                      return true;
+                    });
 }
 
 uint32_t OccludedBundleTwoLevel(const TwoLevelBvh& tl, const RayBundle& rays) {

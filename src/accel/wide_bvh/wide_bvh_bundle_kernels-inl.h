@@ -59,44 +59,27 @@ HWY_INLINE uint32_t OccludedInPackBundle(const TrianglePack& pack, uint32_t coun
   return found;
 }
 
-// The lanes of `st` (a bundle) among `active` whose rays are occluded in `bvh`'s whole tree.
-template <class Count>
-HWY_INLINE uint32_t OccludedBundleInTree(const WideBvh& bvh, const BundleState& st, uint32_t active, Count count) {
-  const auto& nodes = bvh.nodes();
-  if (nodes.empty() || active == 0) return 0;
-  // Rays that miss the tree's box are answered at once.
-  const float lo[3] = {bvh.bounds().lo.x, bvh.bounds().lo.y, bvh.bounds().lo.z};
-  const float hi[3] = {bvh.bounds().hi.x, bvh.bounds().hi.y, bvh.bounds().hi.z};
-  active = TestBundleBox(lo, hi, st, active);
-  if (active == 0) return 0;
-  const Triangle* tris = bvh.scene().triangles.data();
-  const TrianglePack* packs = bvh.packs().data();
+// A bundle's walk down an 8-wide tree of `nodes` from the root: each entry carries the lanes
+// that entered it, children are pushed in slot order (so the last slot, the smallest subtree, is
+// searched first, as in single-ray any-hit), and lanes found occluded leave every entry.
+// `visit(e, lanes, found)` answers entry e for `lanes` (setting `found`) and returns true, or
+// returns false to have the walk open it as a node. Returns the occluded lanes of `active`.
+struct BundleEntry {
+  uint32_t child, count, lanes;
+};
+template <class Count, class Visit>
+HWY_INLINE uint32_t BundleWalk(const WideNode* nodes, const BundleState& st, uint32_t active, Count count,
+                               const Visit& visit) {
   uint32_t occluded = 0;
-
-  // Subtrees to search, each with the lanes that enter it. Children are pushed in slot order, so
-  // the last slot (the smallest subtree) is searched first, as in single-ray any-hit.
-  struct Entry {
-    uint32_t child, count, lanes;
-  };
-  Entry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
+  BundleEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
   int sp = 0;
   stack[sp++] = {0, 0, active};
   while (sp > 0) {
-    const Entry e = stack[--sp];
+    const BundleEntry e = stack[--sp];
     const uint32_t lanes = e.lanes & active;
     if (lanes == 0) continue;
     uint32_t found = 0;
-    if (std::popcount(lanes) < kBundleMinLanes) {
-      for (uint32_t bits = lanes; bits; bits &= bits - 1) {
-        const int k = __builtin_ctz(bits);
-        if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar, StackEntry{e.child, e.count, 0.0f},
-                          count))
-          found |= 1u << k;
-      }
-    } else if (e.count > 0) {
-      count.pack(uint32_t(std::popcount(lanes)), e.count);
-      found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
-    } else {
+    if (!visit(e, lanes, found)) {
       count.node(uint32_t(std::popcount(lanes)));
       const WideNode& n = nodes[e.child];
       for (uint32_t c = 0; c < uint32_t(kWideWidth); ++c) {
@@ -111,6 +94,35 @@ HWY_INLINE uint32_t OccludedBundleInTree(const WideBvh& bvh, const BundleState& 
     if (active == 0) break;
   }
   return occluded;
+}
+
+// The lanes of `st` (a bundle) among `active` whose rays are occluded in `bvh`'s whole tree.
+template <class Count>
+HWY_INLINE uint32_t OccludedBundleInTree(const WideBvh& bvh, const BundleState& st, uint32_t active, Count count) {
+  if (bvh.nodes().empty() || active == 0) return 0;
+  // Rays that miss the tree's box are answered at once.
+  const float lo[3] = {bvh.bounds().lo.x, bvh.bounds().lo.y, bvh.bounds().lo.z};
+  const float hi[3] = {bvh.bounds().hi.x, bvh.bounds().hi.y, bvh.bounds().hi.z};
+  active = TestBundleBox(lo, hi, st, active);
+  if (active == 0) return 0;
+  const Triangle* tris = bvh.scene().triangles.data();
+  const TrianglePack* packs = bvh.packs().data();
+  return BundleWalk(bvh.nodes().data(), st, active, count,
+                    [&](const BundleEntry& e, uint32_t lanes, uint32_t& found) TRACER_INLINE_LAMBDA {
+                      if (std::popcount(lanes) < kBundleMinLanes) {
+                        for (uint32_t bits = lanes; bits; bits &= bits - 1) {
+                          const int k = __builtin_ctz(bits);
+                          if (OccludedBelow(bvh, LaneRay(st, k), st.shear(k), st.tnear, st.tfar,
+                                            StackEntry{e.child, e.count, 0.0f}, count))
+                            found |= 1u << k;
+                        }
+                        return true;
+                      }
+                      if (e.count == 0) return false;
+                      count.pack(uint32_t(std::popcount(lanes)), e.count);
+                      found = OccludedInPackBundle(packs[e.child], e.count, tris, st, lanes);
+                      return true;
+                    });
 }
 
 }  // namespace HWY_NAMESPACE
