@@ -457,12 +457,7 @@ class GltfScene {
       auto [it, fresh] = meshes_.try_emplace({mesh, int(k)});
       if (fresh) it->second = gltf::primitive_mesh(model_, name_, warnings_, p, what);
       if (!it->second) continue;
-      for (const Vec3& v : it->second->positions) {
-        if (!is_finite(v) || std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kMaxCoordinate) {
-          throw error(what + ": a vertex lies beyond +-" + std::string(kMaxCoordinateText));
-        }
-        box.extend(v);
-      }
+      for (const Vec3& v : it->second->positions) box.extend(v);  // each within range (primitive_mesh)
       append_mesh(scene_, m.name.empty() ? what : m.name, *it->second, materials_.material(p.material, scene_));
       it->second.reset();  // placed once: its arrays are the scene's now
     }
