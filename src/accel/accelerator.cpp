@@ -34,20 +34,11 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
   acc.kind = options.kind;
   const auto start = std::chrono::steady_clock::now();
   acc.instanced_scene = scene.instanced();
-  if (scene.instanced() && !is_embree(options.kind)) {
-    if (!traces_instances(options.kind)) {
-      throw UsageError(std::string("--accel ") + std::string(name_of<AccelKind>(kAccelKindNames, options.kind)) + ": " +
-                       scene.source +
-                       " places meshes by instances, which only bvh8 and embree trace (load it for this accelerator to "
-                       "expand them)");
-    }
-    BvhBuildOptions bvh = options.bvh;
-    const bool high = options.quality == BuildQuality::High;
-    bvh.split_budget = high ? kHighSplitBudget : 0.0f;
-    acc.impl = std::make_unique<AccelVariant>(std::in_place_type<TwoLevelBvh>, scene, bvh);
-    acc.name = "bvh8-" + std::get<TwoLevelBvh>(*acc.impl).simd().name() + (high ? "-high" : "") + "-two-level";
-    acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return acc;
+  if (scene.instanced() && !traces_instances(options.kind)) {
+    throw UsageError(std::string("--accel ") + std::string(name_of<AccelKind>(kAccelKindNames, options.kind)) + ": " +
+                     scene.source +
+                     " places meshes by instances, which only bvh8 and embree trace (load it for this accelerator to "
+                     "expand them)");
   }
   switch (options.kind) {
     case AccelKind::Brute:
@@ -66,8 +57,15 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
       BvhBuildOptions bvh = options.bvh;
       const bool high = options.quality == BuildQuality::High;
       bvh.split_budget = high ? kHighSplitBudget : 0.0f;
-      acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, bvh);
-      acc.name = "bvh8-" + std::get<WideBvh>(*acc.impl).simd().name() + (high ? "-high" : "");
+      std::string simd;
+      if (scene.instanced()) {
+        acc.impl = std::make_unique<AccelVariant>(std::in_place_type<TwoLevelBvh>, scene, bvh);
+        simd = std::get<TwoLevelBvh>(*acc.impl).simd().name();
+      } else {
+        acc.impl = std::make_unique<AccelVariant>(std::in_place_type<WideBvh>, scene, bvh);
+        simd = std::get<WideBvh>(*acc.impl).simd().name();
+      }
+      acc.name = "bvh8-" + simd + (high ? "-high" : "");
       break;
     }
     case AccelKind::Embree:
@@ -84,7 +82,7 @@ Accelerator build_accelerator(const Scene& scene, const AccelOptions& options) {
 #endif
     }
   }
-  if (acc.instanced_scene) acc.name += "-two-level";  // Embree's instance geometry
+  if (acc.instanced_scene) acc.name += "-two-level";  // bvh8's TwoLevelBvh, Embree's instance geometry
   acc.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return acc;
 }
