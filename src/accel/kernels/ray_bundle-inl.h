@@ -35,7 +35,7 @@ struct BundleState {
   float org[3];
   float tnear, tfar;
 
-  explicit BundleState(const RayBundle& rays)
+  HWY_INLINE explicit BundleState(const RayBundle& rays)
       : org{rays.org.x, rays.org.y, rays.org.z}, tnear(rays.tnear), tfar(rays.tfar) {
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;

@@ -20,7 +20,7 @@ struct RayShear {
   float sx = 0, sy = 0, sz = 1;
 
   RayShear() = default;
-  explicit RayShear(const Ray& r) : org(r.org) {
+  [[gnu::always_inline]] explicit RayShear(const Ray& r) : org(r.org) {
     kz = max_dimension(abs(r.dir));
     kx = kz == 2 ? 0 : kz + 1;
     ky = kx == 2 ? 0 : kx + 1;

@@ -62,7 +62,7 @@ using WideV = hn::Vec<WideTag>;
 struct NodeRay {
   WideV ox, oy, oz, ix, iy, iz, fx, fy, fz;
   uint32_t near[3], far[3];  // in floats from the node's start
-  explicit NodeRay(const WideRay& r) {
+  HWY_INLINE explicit NodeRay(const WideRay& r) {
     const WideTag d;
     ox = hn::Set(d, r.ox), oy = hn::Set(d, r.oy), oz = hn::Set(d, r.oz);
     ix = hn::Set(d, r.ix), iy = hn::Set(d, r.iy), iz = hn::Set(d, r.iz);
@@ -107,7 +107,7 @@ struct PackRay {
   const RayShear* shear;  // for the lanes the scalar test decides
   WideV okx, oky, okz, sx, sy, sz;
   uint32_t axis[3];  // in floats from a vertex's first row: axes kx, ky, kz
-  explicit PackRay(const RayShear& s) : shear(&s) {
+  HWY_INLINE explicit PackRay(const RayShear& s) : shear(&s) {
     const WideTag d;
     const float org[3] = {s.org.x, s.org.y, s.org.z};
     okx = hn::Set(d, org[s.kx]), oky = hn::Set(d, org[s.ky]), okz = hn::Set(d, org[s.kz]);
