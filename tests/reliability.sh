@@ -66,6 +66,7 @@ printf "$ply"'0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n' ascii 3 > range.ply
 printf "$ply"'0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n' ascii 3 > extra.ply
 printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float x\nend_header\n0 0\n' > twice.ply
 { printf "$ply" binary_little_endian 3; head -c 36 /dev/zero; printf '\003\0\0\0'; } > cut.ply
+{ printf "${ply/face 1/face 2000000}" ascii 3; printf '0 0 0\n1 0 0\n0 1 0\n'; yes '3 0 1 2' | head -n 2000000; } > faces2m.ply
 printf 'mtllib dark.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 100 100 100\nv 101 100 100\nv 100 101 100\nf 1 2 3\nusemtl lamp\nf 4 6 5\n' > dark.obj
 printf 'newmtl lamp\nKe 10 10 10\n' > dark.mtl
 printf 'mtllib grey.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl  Lamp\nf 1 2 3\n' > grey.obj
@@ -304,6 +305,8 @@ cases=(
   "8192 x 8192 denoised, past the memory limit|tracer render --width 8192 --height 8192 --denoise --max-memory-mib 16384 -q|2"
   "Ctrl-C while denoising|timeout --foreground --preserve-status -s INT 3 tracer render --width 1536 --height 1536 --spp 1 --denoise -q -o d.png|130"
   "a scene and its accelerator past --max-memory-mib|tracer render --builtin-spheres 200000 --max-memory-mib 48 --width 8 --height 8 -q|1"
+  "OBJ: the Bunny past --max-memory-mib 8, refused once parsed|tracer render shared-scenes/bunny/bunny.obj --max-memory-mib 8 --width 8 --height 8 -q|1"
+  "PLY: 2M faces past --max-memory-mib 64, refused at its header|tracer render faces2m.ply --max-memory-mib 64 --width 8 --height 8 -q|1"
   "--max-memory-mib 0|tracer render --max-memory-mib 0 -q|2"
   "--aperture 0.1 --focus-distance 1e-30|tracer render --aperture 0.1 --focus-distance 1e-30 -q|2"
   "--build-quality HIGH (names are exact)|tracer render --build-quality HIGH -q|2"

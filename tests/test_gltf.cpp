@@ -687,6 +687,47 @@ TEST(Ply, PolygonsOfAnyIndexTypeAreTriangulated) {
   EXPECT_EQ(warnings[1], "t.ply: element 'edge' ignored");
 }
 
+// Faces whose triangles would not fit the memory limit are refused at the header, before they are
+// read; an OBJ's once parsed, before the scene's arrays are allocated.
+TEST(Ply, FacesAboveTheMemoryLimitAreRefusedAtTheHeader) {
+  std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 100000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  for (int i = 0; i < 100000; ++i) text += "3 0 1 2\n", obj += "f 1 2 3\n";
+  LoadLimits limits;  // 100,000 triangles of 48 bytes, and 96 each for the accelerator: 13.7 MiB, printed whole
+  limits.max_memory = uint64_t(8) << 20;
+  limits.accel_bytes_per_triangle = 96;
+  const std::string tail = " triangles and their accelerator: about 13 MiB needed, more than the memory limit of 8 MiB";
+  const auto error = [&](const auto& load) {
+    try {
+      load();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  const auto ply = [&] {
+    load_ply_from_memory(
+        text, "t.ply", [](const std::string&) {}, limits);
+  };
+  const auto obj_load = [&] {
+    load_obj_from_string(
+        obj, "", "t.obj", [](const std::string&) {}, limits);
+  };
+  EXPECT_EQ(error(ply).rfind("t.ply: its 100000" + tail, 0), 0u) << error(ply);
+  EXPECT_EQ(error(obj_load).rfind("t.obj: its 100000" + tail, 0), 0u) << error(obj_load);
+  limits.max_memory = uint64_t(16) << 20;
+  EXPECT_EQ(load_ply_from_memory(
+                text, "t.ply", [](const std::string&) {}, limits)
+                .size(),
+            100000u);
+  EXPECT_EQ(load_obj_from_string(
+                obj, "", "t.obj", [](const std::string&) {}, limits)
+                .size(),
+            100000u);
+}
+
 TEST(Ply, HostileFilesFailWithOneLineNamingTheFileAndLine) {
   const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
   const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";

@@ -4,9 +4,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
 
+#include "base/errors.hpp"
+#include "base/memory_limit.hpp"
 #include "base/read_input.hpp"
 #include "scene/instances.hpp"
+#include "scene/scene.hpp"
 #include "scene/texture.hpp"
 
 namespace tracer {
@@ -40,6 +44,20 @@ struct LoadLimits {
   // trace no instances).
   bool keep_instances = true;
 };
+
+// Throws InputError when `triangles` (with corner normals and uvs where the file gives them) and
+// the accelerator over them would take more than limits.max_memory: called by the loaders that
+// count a file's triangles before assembling the scene (OBJ after its parse, PLY from its header),
+// so a scene that will not fit is refused before its arrays are allocated.
+inline void refuse_past_memory(const LoadLimits& limits, const std::string& name, uint64_t triangles, bool normals,
+                               bool uvs) {
+  const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits.accel_bytes_per_triangle;
+  const uint64_t bytes = triangles > UINT64_MAX / per_triangle ? UINT64_MAX : triangles * per_triangle;
+  if (bytes <= limits.max_memory) return;
+  throw InputError(memory_refusal(name + ": its " + std::to_string(triangles) + " triangles" +
+                                      (limits.accel_bytes_per_triangle ? " and their accelerator" : ""),
+                                  bytes, limits.max_memory));
+}
 
 // Where a load's time went (--stats): reading the bytes, parsing and checking the OBJ and its
 // MTL, reading and decoding the textures, and assembling the scene's arrays.

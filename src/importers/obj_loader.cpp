@@ -354,6 +354,7 @@ Scene load(std::string_view text, const std::string& name, const fs::path& base_
     if (e) std::rethrow_exception(e);
   }
   if (obj.triangle_count() == 0) throw InputError(name + ": scene has no triangles");
+  refuse_past_memory(limits, name, obj.triangle_count(), obj.any_normal(), obj.any_uv());
   std::vector<std::string> texnames = texture_names(layout.materials);
   if (!limits.read_textures) texnames.assign(texnames.size(), std::string());
   if (!early || early->texnames != texnames) {  // not foreseen: read them now

@@ -50,6 +50,8 @@ class ObjGeometry {
   const std::vector<ObjStatement>& statements() const { return statements_; }
   uint64_t triangle_count() const { return triangles_; }
   uint64_t vertex_count() const { return counts_[0]; }
+  bool any_normal() const { return any_normal_; }  // the scene gets corner normals
+  bool any_uv() const { return any_uv_; }          // and corner uvs
 
   // Writes the triangles into `scene` (triangles, tri_geom, tri_prim, tri_material, and
   // corner_normals / corner_uvs where the file gives any): faces of more than three corners

@@ -281,7 +281,7 @@ uint64_t min_row_bytes(const PlyElement& e, bool ascii) {
 const char* const kUv[][2] = {{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
 
 Scene load(std::string_view bytes, const std::string& name, const WarningSink& warn_in, CancelFlag cancel,
-           LoadPhases* phases) {
+           const LoadLimits& limits, LoadPhases* phases) {
   const WarningSink warn = warn_in ? warn_in : WarningSink(default_warning);
   const auto parse_start = Clock::now();
   WarningLog warnings;
@@ -328,6 +328,8 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
       if (list < 0 || !e.properties[size_t(list)].list || !is_integer(e.properties[size_t(list)].type)) {
         throw InputError(name + ":" + std::to_string(e.line) + ": face has no integer list vertex_indices");
       }
+      // At least a triangle a face: refused here, before the triangles are read.
+      refuse_past_memory(limits, name, e.count, mesh.normals.capacity() > 0, mesh.uvs.capacity() > 0);
       have_faces = true;
     } else {
       warnings.add("element " + in_quotes(e.name) + " ignored");
@@ -411,11 +413,12 @@ Scene load_ply(const std::string& path, const WarningSink& warn, CancelFlag canc
   const auto read_start = Clock::now();
   const InputBytes bytes = map_input(path, cancel, limits.max_obj_bytes);
   if (phases) phases->read_ms = ms_since(read_start);
-  return load(bytes.view(), path, warn, cancel, phases);
+  return load(bytes.view(), path, warn, cancel, limits, phases);
 }
 
-Scene load_ply_from_memory(std::string_view bytes, const std::string& name, const WarningSink& warn) {
-  return load(bytes, name, warn, nullptr, nullptr);
+Scene load_ply_from_memory(std::string_view bytes, const std::string& name, const WarningSink& warn,
+                           const LoadLimits& limits) {
+  return load(bytes, name, warn, nullptr, limits, nullptr);
 }
 
 }  // namespace tracer

@@ -18,11 +18,13 @@ namespace tracer {
 
 // Throws InputError naming the file and, in the header or an ASCII body, the line; memory is
 // bounded by the file's size (counts the file cannot hold are refused before anything is
-// allocated). Cancelled when `cancel` is set during loading.
+// allocated), and faces whose triangles would not fit limits.max_memory are refused at the
+// header. Cancelled when `cancel` is set during loading.
 Scene load_ply(const std::string& path, const WarningSink& warn = {}, CancelFlag cancel = nullptr,
                const LoadLimits& limits = {}, LoadPhases* phases = nullptr);
 
 // The same from memory (fuzzing, tests); `name` stands for the file in messages.
-Scene load_ply_from_memory(std::string_view bytes, const std::string& name, const WarningSink& warn = {});
+Scene load_ply_from_memory(std::string_view bytes, const std::string& name, const WarningSink& warn = {},
+                           const LoadLimits& limits = {});
 
 }  // namespace tracer
