@@ -1,14 +1,15 @@
 // Writes a scene placed N times on a square grid as glTF (tinygltf's writer), for the instancing
-// benchmarks (scripts/benchmarks-instances.sh): every geometry of SCENE placed by N nodes, each
-// turned about y by its own angle; --distinct gives each placement its own mesh (the same
-// accessors), a file tracer loads flat: the instanced scene's triangles, flattened.
+// benchmarks (scripts/benchmarks-instances.sh): every geometry of SCENE placed by N nodes on
+// scene/builtin.hpp's grid (grid_placements), each turned about y by its own angle; --distinct gives each placement its
+// own mesh (the same accessors), a file tracer loads flat: the instanced scene's triangles, flattened.
 //   tracer_make_instances SCENE N OUT.gltf [--distinct]
-#include <cmath>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "importers/scene_file.hpp"
+#include "scene/builtin.hpp"
 #include "scene_writers.hpp"
 
 int main(int argc, char** argv) {
@@ -19,24 +20,17 @@ int main(int argc, char** argv) {
   }
   const Scene scene = load_scene_file(argv[1]);
   const long n = std::strtol(argv[2], nullptr, 10);
-  if (n < 1) {
-    std::fprintf(stderr, "tracer_make_instances: N must be at least 1\n");
+  if (n < 1 || n > long(UINT32_MAX)) {
+    std::fprintf(stderr, "tracer_make_instances: N must be between 1 and 2^32 - 1\n");
     return 2;
   }
-  const Vec3 e = scene.bounds.extent();
-  const double step = 1.1 * double(std::max(e.x, e.z));
-  const auto side = long(std::ceil(std::sqrt(double(n))));
   test::GltfWriteOptions options;
   options.distinct_meshes = argc > 4 && std::string(argv[4]) == "--distinct";
   std::vector<std::array<double, 16>> placements;
-  for (long k = 0; k < n; ++k) {
-    const double a = 0.37 * double(k % side + 3 * (k / side)), c = std::cos(a), s = std::sin(a);
-    placements.push_back(
-        {c, 0, -s, 0, 0, 1, 0, 0, s, 0, c, 0, double(k % side) * step, 0, -double(k / side) * step, 1});
-  }
+  for (const Affine& a : grid_placements(scene.bounds, uint32_t(n))) placements.push_back(a.column_major());
   for (uint32_t g = 0; g < scene.geometries.size(); ++g) options.placements[g] = placements;
   test::write_gltf(scene, argv[3], options);
-  std::printf("%s: %zu triangles placed %ld times (%.4g), grid step %g\n", argv[3], scene.size(), n,
-              double(scene.size()) * double(n), step);
+  std::printf("%s: %zu triangles placed %ld times (%.4g)\n", argv[3], scene.size(), n,
+              double(scene.size()) * double(n));
   return 0;
 }

@@ -514,6 +514,29 @@ TEST_F(Cli, BenchJsonParsesBack) {
   EXPECT_EQ(j["size"][0], 8);
 }
 
+// --scenes instanced: the bunny view's scene placed 100 times and kept once; the variants that
+// trace no instances are not run (n/a), bvh8 and Embree are, on the same 100 placed triangles.
+TEST_F(Cli, BenchTimesTheInstancedSceneWithTheVariantsThatTraceInstances) {
+  std::ofstream(dir_ + "/bunny-views.tsv") << "scene\tobj\teye\tlook\tup\tfov\tlight\tnote\n"
+                                           << "bunny\tok.obj\t0,0,3\t0,0,0\t0,1,0\t45\t0,0,2\tone triangle\n";
+  const auto r = test::run_tracer("bench --scenes instanced --views " + dir_ +
+                                  "/bunny-views.tsv --variants sah,bvh8,embree --size 8x8 --ao 1 --runs 1 --best 1 "
+                                  "--json " +
+                                  dir_ + "/i.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("| Bunny x100 (instanced) | 100 | n/a |"), std::string::npos) << r.output;
+  std::ifstream in(dir_ + "/i.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["cells"].size(), 3u);
+  for (const nlohmann::json& c : j["cells"]) {
+    EXPECT_EQ(c["triangles"], 100);
+    EXPECT_EQ(c["not_traced"], c["variant"] == "sah") << c.dump();
+    if (c["variant"] != "sah") {
+      EXPECT_GT(c["rays"].get<uint64_t>(), 0u) << c.dump();
+    }
+  }
+}
+
 TEST_F(Cli, MoreThreadsThanCoresRunAsAskedWithOurWarning) {
   const auto r = test::run_tracer("render -q --width 16 --height 16 --ao 1 --threads 64 --stats -o " + dir_ + "/t.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;

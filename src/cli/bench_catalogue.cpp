@@ -142,6 +142,10 @@ std::vector<SceneEntry> resolve_scenes(const BenchArgs& a) {
       }
     } else if (item == "builtin") {
       out.push_back({"builtin", "", std::nullopt});
+    } else if (item == "instanced") {
+      const View& bunny = find_view(all_views(), "bunny", views_path, "--scenes instanced");
+      out.push_back({display_name(bunny.name) + " x" + std::to_string(kInstancedPlacements) + " (instanced)", bunny.obj,
+                     std::nullopt, kInstancedPlacements});
     } else if (item.find('/') == std::string::npos && item.find('.') == std::string::npos) {
       add_view(find_view(all_views(), item, views_path, "--scenes"));
     } else {

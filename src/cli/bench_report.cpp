@@ -44,7 +44,10 @@ std::string markdown_tables(const BenchReport& r) {
   const auto row = [&](const auto& value_of) {
     for (const SceneEntry& se : scenes) {
       md << "| " << se.name << " | " << cells[{se.name, variants[0].name}].triangles << " |";
-      for (const Variant& v : variants) md << " " << value_of(se, v, cells[{se.name, v.name}]) << " |";
+      for (const Variant& v : variants) {
+        const Cell& c = cells[{se.name, v.name}];
+        md << " " << (c.not_traced ? std::string("n/a") : value_of(se, v, c)) << " |";
+      }
       md << "\n";
     }
   };
@@ -75,14 +78,15 @@ std::string markdown_tables(const BenchReport& r) {
     header("Speedup over seq (same scene, same run)");
     row([&](const SceneEntry& se, const Variant&, const Cell& c) {
       const Cell& s = cells[{se.name, "seq"}];
-      if (c.timed_out || s.timed_out) return std::string("-");
+      if (c.timed_out || s.timed_out || s.not_traced) return std::string("-");
       return fmt(s.total_ms / c.total_ms, 2) + "x";
     });
     header("Study comparison: speedup over seq, ours / study's");
     row([&](const SceneEntry& se, const Variant& v, const Cell& c) {
       const auto sit = study_ms().find(se.name.substr(0, se.name.find(" (framed)")));
       const Cell& s = cells[{se.name, "seq"}];
-      if (sit == study_ms().end() || !sit->second.count(v.name) || c.timed_out || s.timed_out) return std::string("-");
+      if (sit == study_ms().end() || !sit->second.count(v.name) || c.timed_out || s.timed_out || s.not_traced)
+        return std::string("-");
       const double study_speedup = sit->second.at("seq") / sit->second.at(v.name);
       return fmt(s.total_ms / c.total_ms, 1) + " / " + fmt(study_speedup, 1);
     });
@@ -117,6 +121,7 @@ std::string json_report(const BenchReport& r) {
                           {"variant", c.variant},
                           {"triangles", c.triangles},
                           {"timed_out", c.timed_out},
+                          {"not_traced", c.not_traced},
                           {"load_ms", c.load_ms},
                           {"build_ms", c.build_ms},
                           {"render_ms", c.render_ms},

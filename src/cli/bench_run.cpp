@@ -55,7 +55,7 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
   const Variant& v = job.variant;
   Cell cell;
   cell.variant = v.name;
-  cell.triangles = job.scene.size();
+  cell.triangles = job.scene.instanced_size();
   std::vector<double> builds, renders;
   const auto cell_start = Clock::now();
   for (int run = 0; run < job.runs && !cell.timed_out; ++run) {

@@ -17,12 +17,13 @@ namespace tracer::cli {
 struct Cell {
   std::string scene, variant;
   bool timed_out = false;
+  bool not_traced = false;  // an instanced scene, and a variant that traces no instances: not run
   double load_ms = 0, build_ms = 0, render_ms = 0, total_ms = 0;  // k-best means
   uint64_t rays = 0;
   double mrays = 0;
   size_t triangles = 0;
   std::vector<double> run_ms;
-  bool capped(int runs) const { return !timed_out && int(run_ms.size()) < runs; }
+  bool capped(int runs) const { return !timed_out && !not_traced && int(run_ms.size()) < runs; }
 };
 
 // The mean of the `best` smallest values.

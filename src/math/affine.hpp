@@ -20,6 +20,14 @@ struct Affine {
       for (int k = 0; k < 4; ++k) a.m[r][k] = c[4 * k + r];
     return a;
   }
+  // As a column-major 4x4 matrix, the bottom row (0, 0, 0, 1): from_column_major's inverse.
+  std::array<double, 16> column_major() const {
+    std::array<double, 16> c{};
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 4; ++k) c[size_t(4 * k + r)] = m[size_t(r)][size_t(k)];
+    c[15] = 1.0;
+    return c;
+  }
   // Translation T, rotation R (a unit quaternion x, y, z, w) and scale S, as T * R * S.
   static Affine from_trs(const double* t, const double* q, const double* s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];

@@ -1,5 +1,6 @@
 #include "scene/builtin.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -104,6 +105,29 @@ Scene make_cornell_box(int sphere_triangles) {
   s.camera = CameraSpec{mm(278, 273, -800), mm(278, 273, 0), {0, 1, 0}, 37.5f};
   s.finalize();
   return s;
+}
+
+std::vector<Affine> grid_placements(const Aabb& bounds, uint32_t n) {
+  const Vec3 e = bounds.extent();
+  const double step = 1.1 * double(std::max(e.x, e.z));
+  const auto side = uint32_t(std::ceil(std::sqrt(double(n))));
+  std::vector<Affine> out;
+  out.reserve(n);
+  for (uint32_t k = 0; k < n; ++k) {
+    const double a = 0.37 * double(k % side + 3 * (k / side)), c = std::cos(a), s = std::sin(a);
+    Affine m;
+    m.m = {{{c, 0, s, double(k % side) * step}, {0, 1, 0, 0}, {-s, 0, c, -double(k / side) * step}}};
+    out.push_back(m);
+  }
+  return out;
+}
+
+Scene place_instances(Scene scene, const std::vector<Affine>& placements) {
+  scene.meshes = {Mesh{scene.source, TriangleRange::all(scene), {}, false}};
+  scene.instances.clear();
+  for (const Affine& m : placements) scene.instances.push_back(make_instance(0, m));
+  scene.finalize();
+  return scene;
 }
 
 }  // namespace tracer

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "math/affine.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -24,5 +25,13 @@ IndexedMesh make_box(Vec3 lo, Vec3 hi);
 // and, when sphere_triangles > 0, two spheres of about that many triangles each. It suggests the
 // measured camera (eye at z = -800 mm looking down +z, 37.5 degree field of view).
 Scene make_cornell_box(int sphere_triangles = 0);
+
+// n placements of a scene of box `bounds` on a square grid along +x and -z, 1.1 times its larger
+// horizontal extent apart, each turned about y by its own angle: the instancing benchmarks' layout
+// (bench/make_instances.cpp writes it as glTF; tracer bench's instanced scene builds it).
+std::vector<Affine> grid_placements(const Aabb& bounds, uint32_t n);
+
+// `scene`'s triangles kept once, as one mesh placed by each of `placements`: an instanced scene.
+Scene place_instances(Scene scene, const std::vector<Affine>& placements);
 
 }  // namespace tracer
