@@ -20,10 +20,12 @@
 
 #include "frontend/render_options.hpp"
 #include "frontend/settings_table.hpp"
+#include "importers/scene_file.hpp"
 #include "io/exr_io.hpp"
 #include "io/image_io.hpp"
 #include "scene/builtin.hpp"
 #include "scene/camera.hpp"
+#include "scene_writers.hpp"
 #include "test_util.hpp"
 #include "view/view_command.hpp"
 #include "view/view_server.hpp"
@@ -36,9 +38,12 @@ using nlohmann::json;
 
 class ViewServerTest : public ::testing::Test {
  protected:
+  // The scene the session shows (and the copied command names, through args_.scene).
+  virtual Scene make_scene() { return make_cornell_box(); }
   void SetUp() override {
     std::signal(SIGPIPE, SIG_IGN);  // a request refused from its head may close before its body is sent
-    scene_ = make_cornell_box();
+    dir_ = test::temp_dir();
+    scene_ = make_scene();
     args_.settings.width = 64;
     args_.settings.height = 48;
     args_.spp = 4;
@@ -49,7 +54,6 @@ class ViewServerTest : public ::testing::Test {
     port_ = server_->bind("127.0.0.1", 0);
     session_->start();
     listening_ = std::thread([this] { server_->listen(); });
-    dir_ = test::temp_dir();
   }
   void TearDown() override {
     session_->stop();
@@ -261,6 +265,38 @@ TEST_F(ViewServerTest, FinishedImageIsTheCopiedCommandsRender) {
     for (int y = 0; y < fa.height(); ++y) {
       for (int x = 0; x < fa.width(); ++x) ASSERT_EQ(fa.radiance(x, y), fb.radiance(x, y)) << x << "," << y;
     }
+  }
+}
+
+// An instanced scene (the Cornell box placed three times, kept once: a glTF written here) flies as
+// a flat one does: its finished images, after camera moves, are the copied command's renders.
+class InstancedViewTest : public ViewServerTest {
+ protected:
+  Scene make_scene() override {
+    const Scene box = make_cornell_box();
+    test::GltfWriteOptions options;
+    for (const Affine& a : grid_placements(box.bounds, 3)) {
+      for (uint32_t g = 0; g < box.geometries.size(); ++g) options.placements[g].push_back(a.column_major());
+    }
+    args_.scene.scene = dir_ + "/boxes.gltf";
+    test::write_gltf(box, args_.scene.scene, options);
+    return load_scene_file(args_.scene.scene);
+  }
+};
+
+TEST_F(InstancedViewTest, FinishedImagesAreTheCopiedCommandsRenders) {
+  ASSERT_TRUE(scene_.instanced());
+  EXPECT_EQ(scene_.instances.size(), 3 * scene_.meshes.size());
+  EXPECT_TRUE(accel_.instanced()) << accel_.name;
+  for (const std::string& change : {std::string(R"({"eye": [-2, 3, 4], "look": [2, 1, -2], "spp": 2})"),
+                                    std::string(R"({"integrator": "ao", "eye": [1, 1, 3], "spp": 1})")}) {
+    ASSERT_EQ(post(change)->status, 200) << change;
+    const auto frame = complete_frame();
+    ASSERT_TRUE(frame) << change;
+    std::ofstream(dir_ + "/view.png", std::ios::binary) << frame->bytes;
+    const auto rendered = run_copied_command(dir_ + "/render.png");
+    ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
+    EXPECT_EQ(read_image(dir_ + "/view.png").rgb, read_image(dir_ + "/render.png").rgb) << change;
   }
 }
 
