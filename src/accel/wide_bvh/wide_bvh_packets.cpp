@@ -12,127 +12,13 @@
 #include <hwy/highway.h>
 
 #include <bit>
-#include <cmath>
 
-#include "accel/kernels/simd_lanes-inl.h"
 #include "accel/wide_bvh/wide_bvh.hpp"
+#include "accel/wide_bvh/wide_bvh_packet_kernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
 namespace HWY_NAMESPACE {
-namespace hn = hwy::HWY_NAMESPACE;
-
-// Per-lane constants and running results of one packet, as SoA arrays.
-struct PacketState {
-  HWY_ALIGN float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
-  HWY_ALIGN float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];    // reciprocal direction
-  HWY_ALIGN float fx[kPacketSize], fy[kPacketSize], fz[kPacketSize];    // ... times SlabGuards::kFarGuard
-  HWY_ALIGN int32_t nx[kPacketSize], ny[kPacketSize], nz[kPacketSize];  // -1 where that reciprocal is negative
-  HWY_ALIGN float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];    // shear constants (RayShear)
-  HWY_ALIGN float tnear[kPacketSize];
-  HWY_ALIGN float t[kPacketSize], u[kPacketSize], v[kPacketSize];  // closest hit so far (t = tfar if none)
-  HWY_ALIGN int32_t tri[kPacketSize];  // its scene index with the sign bit flipped: signed order = unsigned order
-  const float* okx;                    // the origin component along the shared shear axes
-  const float* oky;
-  const float* okz;
-  int kx, ky, kz;
-  const RayPacket* rays;
-};
-
-constexpr int32_t kFlip = INT32_MIN;
-
-// Tests child `c` of `n` against the lanes in `mask`: returns the lanes that enter it before
-// their closest hit, and the entry distance of the first of them (the visiting order: in a
-// coherent packet one ray's order is the packet's, and it costs no reduction across lanes).
-HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState& st, uint32_t mask, float& entry) {
-  const hn::ScalableTag<float> d;
-  using L = SimdLanes<decltype(d)>;
-  const size_t N = hn::Lanes(d);
-  const auto lo_x = hn::Set(d, n.lo_x[c]), lo_y = hn::Set(d, n.lo_y[c]), lo_z = hn::Set(d, n.lo_z[c]);
-  const auto hi_x = hn::Set(d, n.hi_x[c]), hi_y = hn::Set(d, n.hi_y[c]), hi_z = hn::Set(d, n.hi_z[c]);
-  HWY_ALIGN float t0s[kPacketSize];
-  uint32_t hits = 0;
-  for (size_t i = 0; i < size_t(kPacketSize); i += N) {
-    const uint32_t chunk = ChunkBits(mask, i, N);
-    if (chunk == 0) continue;
-    const auto ox = hn::Load(d, st.ox + i), oy = hn::Load(d, st.oy + i), oz = hn::Load(d, st.oz + i);
-    Lanes3<L::V> near, far;  // each lane's planes relative to its own origin
-    NearFarPlanes(d, st.nx, st.ny, st.nz, i, {lo_x - ox, lo_y - oy, lo_z - oz}, {hi_x - ox, hi_y - oy, hi_z - oz}, near,
-                  far);
-    const Lanes3<L::V> inv{hn::Load(d, st.ix + i), hn::Load(d, st.iy + i), hn::Load(d, st.iz + i)};
-    const Lanes3<L::V> inv_far{hn::Load(d, st.fx + i), hn::Load(d, st.fy + i), hn::Load(d, st.fz + i)};
-    L::V t0;
-    const auto enters = slab_test<L>(near, far, inv, inv_far, hn::Load(d, st.tnear + i), hn::Load(d, st.t + i), t0);
-    const auto hit = hn::And(enters, LaneMask(d, chunk));
-    if (hn::AllFalse(d, hit)) continue;
-    hits |= Bits(d, hit) << i;
-    hn::Store(t0, d, t0s + i);
-  }
-  entry = hits ? t0s[__builtin_ctz(hits)] : kInfinity;
-  return hits;
-}
-
-// Triangle `k` of `pack` against the lanes in `mask`, updating each lane's closest hit exactly
-// as intersect_range() does for one ray.
-HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, PacketState& st,
-                                        uint32_t mask) {
-  const hn::ScalableTag<float> d;
-  using L = SimdLanes<decltype(d)>;
-  const hn::RebindToSigned<decltype(d)> di;
-  const size_t N = hn::Lanes(d);
-  const uint32_t tri = p.id[k];
-  const int32_t id = int32_t(tri ^ uint32_t(kFlip));
-  const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
-  const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
-  const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
-  const auto vid = hn::Set(di, id);
-  for (size_t i = 0; i < size_t(kPacketSize); i += N) {
-    const uint32_t chunk = ChunkBits(mask, i, N);
-    if (chunk == 0) continue;
-    const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
-    const ShearedTriangle<L::V> s =
-        shear_triangle<L>({ax0 - okx, ay0 - oky, az0 - okz}, {bx0 - okx, by0 - oky, bz0 - okz},
-                          {cx0 - okx, cy0 - oky, cz0 - okz}, hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
-    const auto best_t = hn::Load(d, st.t + i);
-    const auto best_id = hn::Load(di, st.tri + i);
-    const TriangleLanes<L> found =
-        triangle_hit<L>(s, passes_outside<L>(s), hn::Load(d, st.sz + i), hn::Load(d, st.tnear + i), best_t);
-    // closer(): nearer t wins; equal t goes to the lower scene index.
-    auto hit = hn::And(found.hit, hn::Or(hn::Lt(found.t, best_t),
-                                         hn::And(hn::Eq(found.t, best_t), hn::RebindMask(d, hn::Lt(vid, best_id)))));
-    hit = hn::And(hit, LaneMask(d, chunk));
-    // Lanes exactly on an edge in float are decided by the scalar test in double, as they would
-    // be for that ray alone; their vector result is dropped.
-    const auto on_edge = on_an_edge<L>(s);
-    hit = hn::AndNot(on_edge, hit);
-    const auto keep = hn::Not(hit);
-    hn::Store(hn::IfThenElse(keep, best_t, found.t), d, st.t + i);
-    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.u + i), found.u), d, st.u + i);
-    hn::Store(hn::IfThenElse(keep, hn::Load(d, st.v + i), found.v), d, st.v + i);
-    hn::Store(hn::IfThenElse(hn::RebindMask(di, keep), best_id, vid), di, st.tri + i);
-    for (uint32_t bits = Bits(d, on_edge) & chunk; bits; bits &= bits - 1) {
-      const size_t lane = i + size_t(__builtin_ctz(bits));
-      const RayShear shear(st.rays->ray(int(lane)));
-      const uint32_t best_tri = uint32_t(st.tri[lane]) ^ uint32_t(kFlip);
-      Hit h;
-      h.t = st.t[lane];
-      h.tri = best_tri;
-      TriangleHit th;
-      if (intersect_triangle(shear, tris[tri], st.tnear[lane], h.t, th) && closer(th.t, tri, h)) {
-        st.t[lane] = th.t;
-        st.u[lane] = th.u;
-        st.v[lane] = th.v;
-        st.tri[lane] = id;
-      }
-    }
-  }
-}
-
-struct PacketEntry {
-  uint32_t child, count;  // count > 0: a leaf pack
-  uint32_t lanes;         // the rays that entered this child
-  float t;                // their smallest entry distance
-};
 
 template <class Count>
 void IntersectPacketWideT(const WideBvh& bvh, const RayPacket& rays, Hit* hits, Count count, TraversalCounts* counts) {
@@ -144,44 +30,7 @@ void IntersectPacketWideT(const WideBvh& bvh, const RayPacket& rays, Hit* hits, 
   }
   if (active == 0 || bvh.nodes().empty()) return;
   PacketState st;
-  st.rays = &rays;
-  st.kx = st.ky = st.kz = -1;
-  bool shared_axes = true;
-  for (int lane = 0; lane < kPacketSize; ++lane) {
-    const bool on = (active >> lane) & 1u;
-    // Inactive lanes get harmless values; the masks keep them out of every result.
-    const Ray r = on ? rays.ray(lane) : rays.ray(__builtin_ctz(active));
-    const RayShear shear(r);
-    if (on) {
-      if (st.kx < 0) {
-        st.kx = shear.kx;
-        st.ky = shear.ky;
-        st.kz = shear.kz;
-      }
-      shared_axes &= shear.kx == st.kx && shear.ky == st.ky && shear.kz == st.kz;
-    }
-    st.ox[lane] = r.org.x;
-    st.oy[lane] = r.org.y;
-    st.oz[lane] = r.org.z;
-    const RayBoxTest box(r);
-    st.ix[lane] = box.inv[0];
-    st.iy[lane] = box.inv[1];
-    st.iz[lane] = box.inv[2];
-    st.fx[lane] = box.inv_far[0];
-    st.fy[lane] = box.inv_far[1];
-    st.fz[lane] = box.inv_far[2];
-    st.nx[lane] = std::signbit(box.inv[0]) ? -1 : 0;
-    st.ny[lane] = std::signbit(box.inv[1]) ? -1 : 0;
-    st.nz[lane] = std::signbit(box.inv[2]) ? -1 : 0;
-    st.sx[lane] = shear.sx;
-    st.sy[lane] = shear.sy;
-    st.sz[lane] = shear.sz;
-    st.tnear[lane] = r.tnear;
-    st.t[lane] = r.tfar;
-    st.u[lane] = st.v[lane] = 0.0f;
-    st.tri[lane] = int32_t(kInvalidIndex ^ uint32_t(kFlip));
-  }
-  if (!shared_axes) {
+  if (!InitPacketState(rays, active, st)) {  // rare for primary rays: ray by ray
     for (uint32_t bits = active; bits; bits &= bits - 1) {
       const int lane = __builtin_ctz(bits);
       if (counts)
@@ -192,50 +41,7 @@ void IntersectPacketWideT(const WideBvh& bvh, const RayPacket& rays, Hit* hits, 
     return;
   }
   count.rays(uint32_t(std::popcount(active)));
-  const float* org[3] = {st.ox, st.oy, st.oz};
-  st.okx = org[st.kx];
-  st.oky = org[st.ky];
-  st.okz = org[st.kz];
-
-  const WideNode* nodes = bvh.nodes().data();
-  const TrianglePack* packs = bvh.packs().data();
-  const Triangle* tris = bvh.scene().triangles.data();
-  PacketEntry stack[kWideWidth * (Bvh::kMaxDepth + 2)];
-  int sp = 0;
-  PacketEntry cur{0, 0, active, 0.0f};
-  for (;;) {
-    if (cur.count == 0) {
-      count.node(uint32_t(std::popcount(cur.lanes)));
-      const WideNode& n = nodes[cur.child];
-      PacketEntry hit[kWideWidth];
-      int k = 0;
-      for (int c = 0; c < kWideWidth; ++c) {
-        if (!(n.lo_x[c] <= n.hi_x[c])) continue;  // empty slot
-        float entry;
-        const uint32_t lanes = TestChildPacket(n, c, st, cur.lanes, entry);
-        if (lanes == 0) continue;
-        // Insertion sort, farthest first: the nearest ends up last and is visited next.
-        PacketEntry e{n.child[c], n.count[c], lanes, entry};
-        int m = k++;
-        while (m > 0 && hit[m - 1].t < e.t) {
-          hit[m] = hit[m - 1];
-          --m;
-        }
-        hit[m] = e;
-      }
-      if (k > 0) {
-        for (int c = 0; c < k - 1; ++c) stack[sp++] = hit[c];
-        cur = hit[k - 1];
-        continue;
-      }
-    } else {
-      count.pack(uint32_t(std::popcount(cur.lanes)), cur.count);
-      const TrianglePack& p = packs[cur.child];
-      for (uint32_t k = 0; k < cur.count; ++k) IntersectTrianglePacket(p, int(k), tris, st, cur.lanes);
-    }
-    if (sp == 0) break;
-    cur = stack[--sp];
-  }
+  ClosestInTreePacket(bvh, st, active, count);
   for (uint32_t bits = active; bits; bits &= bits - 1) {
     const int lane = __builtin_ctz(bits);
     Hit& h = hits[lane];
