@@ -221,6 +221,50 @@ TEST_F(TwoLevel, BundlesAnswerAsSingleRays) {
   EXPECT_GT(occluded, rays.size() / 10);
 }
 
+// A packet's lanes get the hits intersect() gives their rays, bit for bit: coherent packets (one
+// origin, directions a few degrees apart, as a 4x4 pixel block's) and incoherent ones (random
+// rays, whose shear axes differ, so the mesh level takes its ray-by-ray path), some lanes off.
+TEST_F(TwoLevel, PacketsAnswerAsSingleRays) {
+  const Scene kept = load(path_, true);
+  const TwoLevelBvh tree(kept, BvhBuildOptions{});
+  const std::vector<Ray> rays = test::random_rays(kept, test::ray_budget(20000), 12);
+  size_t hit = 0;
+  for (size_t i = 0; i + 16 <= rays.size(); i += 16) {
+    const bool coherent = (i / 16) % 2 == 0;
+    RayPacket packet;
+    for (int k = 0; k < 16; ++k) {
+      if ((i / 16 + size_t(k)) % 7 == 0) continue;  // a lane off
+      Ray r = rays[i + size_t(k)];
+      if (coherent) {
+        r.org = rays[i].org;
+        r.dir = normalize(rays[i].dir + 0.02f * Vec3{float(k % 4) - 1.5f, float(k / 4) - 1.5f, 0.5f});
+      }
+      packet.set(k, r);
+    }
+    Hit hits[16], counted[16];
+    TraversalCounts counts;
+    tree.intersect_packet(packet, hits);
+    tree.intersect_packet(packet, counted, counts);
+    for (int k = 0; k < 16; ++k) {
+      if (!(packet.active >> k & 1)) continue;
+      Hit alone;
+      tree.intersect(packet.ray(k), alone);
+      for (const Hit* h : {&hits[k], &counted[k]}) {
+        ASSERT_EQ(h->tri, alone.tri) << "packet " << i / 16 << " lane " << k;
+        ASSERT_EQ(h->inst, alone.inst) << "packet " << i / 16 << " lane " << k;
+        ASSERT_EQ(std::bit_cast<uint32_t>(h->t), std::bit_cast<uint32_t>(alone.t));
+        ASSERT_EQ(std::bit_cast<uint32_t>(h->u), std::bit_cast<uint32_t>(alone.u));
+        ASSERT_EQ(std::bit_cast<uint32_t>(h->v), std::bit_cast<uint32_t>(alone.v));
+        ASSERT_EQ(h->geomID, alone.geomID);
+        ASSERT_EQ(h->primID, alone.primID);
+      }
+      hit += alone.valid() ? 1 : 0;
+    }
+    EXPECT_EQ(counts.rays, uint64_t(std::popcount(packet.active)));
+  }
+  EXPECT_GT(hit, rays.size() / 10);
+}
+
 // --count counts the top level's nodes and, below each instance entered, its mesh tree's: one
 // instance placed untransformed (the ray in its space is the ray) counts the top root and exactly
 // what the mesh's own tree counts; another far away is never entered.

@@ -122,9 +122,7 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("lighting     %s\n", str("lighting").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              !j["packets"].get<bool>() ? ""
-              : accel.instanced() && !is_embree(accel.kind)
-                  ? ", AO rays in bundles (primary rays one by one: no packet kernel)"
+              !j["packets"].get<bool>()       ? ""
               : accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles"
               : is_embree(accel.kind)         ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
                                               : ", AO rays in bundles");

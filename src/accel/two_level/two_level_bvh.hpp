@@ -2,8 +2,8 @@
 // bottom level, built once however many instances place it) and an 8-wide tree over the
 // instances' world boxes (the top level, one instance per leaf). A ray reaching an instance is
 // moved into its mesh's space by the inverse transform (direction unnormalised, so distances
-// along it are the world ray's) and traced there with the 8-wide BVH's own kernels. AO bundles
-// are traced together; primary rays one by one (no packet kernel yet).
+// along it are the world ray's) and traced there with the 8-wide BVH's own kernels: single rays,
+// primary packets and AO bundles alike.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +28,10 @@ class TwoLevelBvh {
   // The same queries, counting both levels' nodes (and the meshes' packs) into `counts`.
   bool intersect(const Ray& ray, Hit& hit, TraversalCounts& counts) const;
   bool occluded(const Ray& ray, TraversalCounts& counts) const;
+  // Closest hits of the rays of a packet (up to 16 coherent rays, e.g. a 4x4 pixel block): each
+  // lane's hit is the one intersect() gives its ray; lanes not in rays.active are left alone.
+  void intersect_packet(const RayPacket& rays, Hit* hits) const;
+  void intersect_packet(const RayPacket& rays, Hit* hits, TraversalCounts& counts) const;
   // The lanes of rays.active whose rays (up to 16 leaving one point) are occluded, each the answer
   // occluded() gives its ray: the top level searched with the bundle's open rays, each instance's
   // mesh by the 8-wide BVH's bundle kernel with the bundle moved into its space. `origin` unused.
