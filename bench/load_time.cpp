@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   const tracer::Executor executor(tracer::Strategy::Tbb, threads);
   tracer::LoadLimits limits;
+  limits.max_obj_bytes = UINT64_MAX;  // the file is named on purpose, however large
   limits.for_each = [&executor](size_t count, const std::function<void(size_t)>& body) {
     executor.for_each(count, body);
   };
