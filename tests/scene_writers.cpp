@@ -159,6 +159,21 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
   }
   use_extensions(m);
   tg::Scene root;
+  // The nodes placing the last mesh written: one per transform listed for geometry g (one
+  // untransformed if none), each with a copy of the mesh with distinct_meshes.
+  const auto place = [&](uint32_t g) {
+    const auto placed = options.placements.find(g);
+    const size_t nodes = placed == options.placements.end() ? 1 : placed->second.size();
+    for (size_t k = 0; k < nodes; ++k) {
+      tg::Node node;
+      if (options.distinct_meshes && k > 0) m.meshes.push_back(m.meshes.back());
+      node.mesh = int(m.meshes.size() - 1);
+      if (placed != options.placements.end()) node.matrix.assign(placed->second[k].begin(), placed->second[k].end());
+      m.nodes.push_back(node);
+      root.nodes.push_back(int(m.nodes.size() - 1));
+    }
+  };
+  tg::Mesh all;  // with one_mesh: every geometry's primitives
   for (uint32_t g = 0; g < scene.geometries.size(); ++g) {
     const Geometry& geom = scene.geometries[g];
     tg::Mesh mesh;
@@ -184,17 +199,17 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
       mesh.primitives.push_back(p);
       t = run;
     }
-    m.meshes.push_back(mesh);
-    const auto placed = options.placements.find(g);
-    const size_t nodes = placed == options.placements.end() ? 1 : placed->second.size();
-    for (size_t k = 0; k < nodes; ++k) {
-      tg::Node node;
-      if (options.distinct_meshes && k > 0) m.meshes.push_back(m.meshes.back());
-      node.mesh = int(m.meshes.size() - 1);
-      if (placed != options.placements.end()) node.matrix.assign(placed->second[k].begin(), placed->second[k].end());
-      m.nodes.push_back(node);
-      root.nodes.push_back(int(m.nodes.size() - 1));
+    if (options.one_mesh) {
+      all.primitives.insert(all.primitives.end(), mesh.primitives.begin(), mesh.primitives.end());
+      continue;
     }
+    m.meshes.push_back(mesh);
+    place(g);
+  }
+  if (options.one_mesh && !all.primitives.empty()) {
+    all.name = "scene";
+    m.meshes.push_back(all);
+    place(0);
   }
   if (scene.camera) {
     const CameraSpec& c = *scene.camera;

@@ -21,6 +21,9 @@ struct GltfWriteOptions {
   // Each placement a mesh of its own (sharing the first's accessors): a file tracer loads flat,
   // the same triangles as the instanced one.
   bool distinct_meshes = false;
+  // Every geometry a primitive of one mesh (a building as exporters write it), placed by the
+  // transforms listed for geometry 0.
+  bool one_mesh = false;
 };
 
 // Every triangle, one indexed primitive per run of one material within a geometry (corners equal
