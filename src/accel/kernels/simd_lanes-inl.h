@@ -15,6 +15,13 @@
 
 #include "accel/kernels/lane_kernels.hpp"
 
+// The leaf actions the traversals hand their walkers are lambdas, which always_inline on the
+// walker does not reach: without this they are called per leaf (measured: 8 more instructions per
+// AO ray, docs/bench/LOG.md).
+#ifndef TRACER_INLINE_LAMBDA
+#define TRACER_INLINE_LAMBDA __attribute__((always_inline))
+#endif
+
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
 namespace HWY_NAMESPACE {

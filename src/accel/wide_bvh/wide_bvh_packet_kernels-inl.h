@@ -19,10 +19,6 @@
 #include "accel/kernels/simd_lanes-inl.h"
 #include "accel/wide_bvh/wide_bvh.hpp"
 
-#ifndef TRACER_INLINE_LAMBDA
-#define TRACER_INLINE_LAMBDA __attribute__((always_inline))
-#endif
-
 HWY_BEFORE_NAMESPACE();
 namespace tracer {
 namespace HWY_NAMESPACE {
