@@ -55,4 +55,15 @@ class TwoLevelBvh {
   SimdDispatch simd_;
 };
 
+// The ray in instance `in`'s mesh space, up to `tfar`: origin and direction moved by the inverse
+// transform, the direction not renormalised, so t measures the same points in both spaces.
+inline Ray to_object(const Instance& in, const Ray& ray, float tfar) {
+  Ray local;
+  local.org = in.to_object.point(ray.org);
+  local.dir = in.to_object.vector(ray.dir);
+  local.tnear = ray.tnear;
+  local.tfar = tfar;
+  return local;
+}
+
 }  // namespace tracer
