@@ -9,9 +9,11 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <random>
 
 #include "render/render_tile.hpp"
+#include "render/stream_order.hpp"
 
 #include "accel/accelerator.hpp"
 #include "accel/builders/spatial_split.hpp"
@@ -687,6 +689,138 @@ TEST(RayBundles, RaysThroughVerticesAndEdges) {
     EXPECT_EQ(bundle_disagreements(Bvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh";
     EXPECT_EQ(bundle_disagreements(WideBvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh8";
   }
+}
+
+// The rays of `cases` (every active lane, in order) as sorted streams of up to kCapacity rays.
+std::vector<std::unique_ptr<RayStream>> streams_of(const std::vector<BundleCase>& cases) {
+  std::vector<std::unique_ptr<RayStream>> out;
+  for (const BundleCase& c : cases) {
+    for (uint32_t bits = c.rays.active; bits; bits &= bits - 1) {
+      if (out.empty() || out.back()->full()) out.push_back(std::make_unique<RayStream>());
+      out.back()->push(c.rays.ray(__builtin_ctz(bits)), 0);
+    }
+  }
+  for (auto& s : out) sort_stream(*s);
+  return out;
+}
+
+// Rays whose stream answer differs from occluded() of the ray alone.
+template <class A>
+size_t stream_disagreements(const A& accel, const std::vector<std::unique_ptr<RayStream>>& streams) {
+  size_t bad = 0;
+  for (const auto& s : streams) {
+    StreamMask got;
+    accel.occluded_stream(*s, got);
+    for (uint32_t i = 0; i < s->size; ++i) {
+      const bool alone = accel.occluded(s->ray(i));
+      if (alone != got.test(i) && bad++ < 3) ADD_FAILURE() << "stream ray " << i << ": alone " << alone;
+    }
+    for (uint32_t i = s->size; i < RayStream::kCapacity; ++i) {
+      if (got.test(i) && bad++ < 3) ADD_FAILURE() << "a slot without a ray reported occluded";
+    }
+  }
+  return bad;
+}
+
+TEST(RayStreams, SameAnswersAsSingleRaysOnEveryTarget) {
+  // The bundles' AO-style rays (on and off the surface, along the axes, finite and unbounded),
+  // sorted and traced as streams: packets of up to 16 rays from different points, the occluder
+  // cache carried from group to group.
+  for_each_target_and_scene([](const Scene& scene, SimdTarget target) {
+    const auto streams = streams_of(bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 23));
+    const WideBvh wide(scene, for_target(target));
+    EXPECT_EQ(stream_disagreements(wide, streams), 0u) << "bvh8";
+  });
+}
+
+TEST(RayStreams, RaysThroughVerticesAndEdges) {
+  const Scene scene = make_cornell_box(800);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  std::vector<BundleCase> cases;
+  for (uint32_t i = 0; i < scene.size(); ++i) {
+    const Triangle& t = scene.triangles[i];
+    for (const Vec3& v : {t.v0, t.v1, t.v2, (t.v0 + t.v1) * 0.5f}) {
+      BundleCase c;
+      c.rays.org = {v.x, scene.bounds.hi.y + 1.0f, v.z};
+      c.rays.set_direction(0, {0, -1, 0});
+      for (int k = 1; k < 4; ++k) c.rays.set_direction(k, ao_direction({0, -1, 0}, u01(rng), u01(rng)));
+      c.origin = i;
+      cases.push_back(c);
+    }
+  }
+  const auto streams = streams_of(cases);
+  for (const SimdTarget target : targets())
+    EXPECT_EQ(stream_disagreements(WideBvh(scene, for_target(target)), streams), 0u) << target_name(target);
+}
+
+TEST(RayStreams, EmbreeStreamsAnswerAsEmbreeSingleRays) {
+  if (!embree_available()) GTEST_SKIP() << "no Embree in this build";
+  const Scene scene = make_cornell_box(3000);
+  const Accelerator embree = build_accelerator(scene, AccelOptions{.kind = AccelKind::Embree});
+  const auto streams = streams_of(bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 29));
+  embree.visit([&](const auto& a) {
+    if constexpr (requires(const RayStream& s, StreamMask& m) { a.occluded_stream(s, m); }) {
+      EXPECT_EQ(stream_disagreements(a, streams), 0u);
+    } else {
+      ADD_FAILURE() << "Embree has no stream kernel";
+    }
+  });
+}
+
+TEST(RayStreams, TheSortIsAStablePermutationGroupedByShearClass) {
+  // Random directions with zero components, exact axes and a zero vector among them.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  auto s = std::make_unique<RayStream>();
+  for (uint32_t i = 0; i < RayStream::kCapacity - 5; ++i) {
+    Ray r;
+    r.org = {u(rng), u(rng), u(rng)};
+    r.dir = {u(rng), u(rng), u(rng)};
+    if (i % 9 == 0) r.dir.y = 0.0f;
+    if (i % 31 == 0) r.dir = {0.0f, i % 2 ? 1.0f : -1.0f, 0.0f};
+    if (i == 100) r.dir = {0.0f, 0.0f, 0.0f};
+    s->push(r, uint16_t(i % 256));
+  }
+  sort_stream(*s);
+  std::vector<uint32_t> seen(s->size, 0);
+  uint32_t begin = 0;
+  for (uint32_t cls = 0; cls < 6; ++cls) {
+    ASSERT_LE(begin, s->class_end[cls]);
+    for (uint32_t at = begin; at < s->class_end[cls]; ++at) {
+      const uint32_t i = s->order[at];
+      ASSERT_LT(i, s->size);
+      ++seen[i];
+      EXPECT_EQ(shear_class(s->ray(i).dir), cls) << "ray " << i;
+      if (at > begin) {
+        const uint32_t prev = s->order[at - 1];
+        const auto key = [&](uint32_t k) { return stream_key(s->ray(k).dir.x, s->ray(k).dir.y, s->ray(k).dir.z); };
+        EXPECT_TRUE(key(prev) < key(i) || (key(prev) == key(i) && prev < i)) << "at " << at;
+      }
+    }
+    begin = s->class_end[cls];
+  }
+  EXPECT_EQ(begin, s->size);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1u), std::ptrdiff_t(s->size)) << "not a permutation";
+  // The same rays give the same order.
+  std::vector<uint32_t> first(s->order, s->order + s->size);
+  sort_stream(*s);
+  EXPECT_TRUE(std::equal(first.begin(), first.end(), s->order));
+}
+
+TEST(RayStreams, CountersCountTheStreamStage) {
+  const Scene scene = make_cornell_box(800);
+  const WideBvh wide(scene, BvhBuildOptions{});
+  const auto streams = streams_of(bundles_for(scene, 600, 31));
+  ASSERT_FALSE(streams.empty());
+  TraversalCounts counts;
+  StreamMask counted, plain;
+  wide.occluded_stream(*streams[0], counted, counts);
+  wide.occluded_stream(*streams[0], plain);
+  EXPECT_EQ(counts.rays, streams[0]->size);
+  EXPECT_GT(counts.nodes, 0u);
+  EXPECT_GT(counts.packs, 0u);
+  EXPECT_TRUE(std::equal(std::begin(counted.words), std::end(counted.words), std::begin(plain.words)));
 }
 
 }  // namespace

@@ -262,4 +262,33 @@ uint32_t EmbreeAccel::occluded_bundle_from(const RayBundle& rays, uint32_t) cons
   return occluded16(rtc_scene_, rays.active, r, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
 }
 
+void EmbreeAccel::occluded_stream(const RayStream& rays, StreamMask& occluded) const {
+  static thread_local std::vector<RTCRay> stream;  // grows once per thread to a stream's size
+  stream.resize(rays.size);
+  for (uint32_t at = 0; at < rays.size; ++at) {
+    const uint32_t i = rays.order[at];
+    const RayStream::Entry& e = rays.rays[i];
+    RTCRay& r = stream[at];
+    r.org_x = e.org.x;
+    r.org_y = e.org.y;
+    r.org_z = e.org.z;
+    r.tnear = e.tnear;
+    r.dir_x = e.dir.x;
+    r.dir_y = e.dir.y;
+    r.dir_z = e.dir.z;
+    r.time = 0.0f;
+    r.tfar = e.tfar;
+    r.mask = 0xffffffffu;
+    r.id = i;
+    r.flags = 0;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcOccluded1M(rtc_scene_, &context, stream.data(), rays.size, sizeof(RTCRay));
+  for (uint32_t at = 0; at < rays.size; ++at) {
+    if (stream[at].tfar < 0.0f) occluded.set(rays.order[at]);  // Embree sets tfar to -inf on a hit
+  }
+}
+
 }  // namespace tracer

@@ -12,6 +12,7 @@
 #include "base/errors.hpp"
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
+#include "math/ray_stream.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -32,6 +33,9 @@ class EmbreeAccel {
   void intersect_packet(const RayPacket& rays, Hit* hits) const;
   uint32_t occluded_packet(const RayPacket& rays) const;
   uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
+  // The stream API on the same sorted rays the 8-wide BVH's streams take: rtcOccluded1M over
+  // the stream in rays.order, flagged coherent.
+  void occluded_stream(const RayStream& rays, StreamMask& occluded) const;
   size_t memory_bytes() const { return static_cast<size_t>(std::max<int64_t>(0, peak_bytes_.load())); }
 
  private:

@@ -14,6 +14,7 @@
 #include "accel/kernels/traversal_counts.hpp"
 #include "accel/kernels/triangle_pack.hpp"
 #include "math/ray_packet.hpp"
+#include "math/ray_stream.hpp"
 
 namespace tracer {
 
@@ -57,6 +58,11 @@ class WideBvh {
   // ray); where few do, each goes on alone from there. `origin` (the triangle they leave) is not
   // needed by this tree; the binary BVH starts from it.
   uint32_t occluded_bundle_from(const RayBundle& rays, uint32_t origin) const;
+  // Sets in `occluded` the rays of `rays` that are occluded, each the answer occluded() gives it:
+  // the rays taken in rays.order by groups of up to 16 of one shear class, each group traversed
+  // as a packet (wide_bvh_streams.cpp).
+  void occluded_stream(const RayStream& rays, StreamMask& occluded) const;
+  void occluded_stream(const RayStream& rays, StreamMask& occluded, TraversalCounts& counts) const;
 
   const WideNodeArray& nodes() const { return nodes_; }
   const PackArray& packs() const { return packs_; }
