@@ -117,6 +117,9 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --accel bvh8 --simd off", 2, "--simd off: bvh8 is the SIMD tree"},
       {"render --simd-target neon", 2, "--simd-target: unknown target 'neon'"},
       {"render --accel brute --packets", 2, "--packets: needs --accel bvh, bvh8 or embree"},
+      {"render --integrator ao --accel bvh --streams", 2, "--streams: needs --accel bvh8 or embree"},
+      {"render --integrator ao --no-packets --streams", 2, "--streams: traces rays together, which --no-packets"},
+      {"render --integrator path --streams", 2, "--streams: only for --integrator ao"},
       {"render --accel simd-brute --simd off", 2, "--simd off: simd-brute is the SIMD brute force"},
       {"render --up 0,0,0", 2, "--up: must not be the zero vector"},
       {"render --traversal-cost 0", 2, "--traversal-cost: must be above 0"},
@@ -580,8 +583,8 @@ TEST_F(Cli, RendersAViewWithItsCameraAndLight) {
 }
 
 TEST_F(Cli, DefaultIsTheFastestPathWithTheScalarImage) {
-  // No flags: the 8-wide BVH with packets and bundles; the same image as the scalar binary BVH
-  // tracing every ray alone. --simd off alone asks for that scalar tree.
+  // No flags: the 8-wide BVH with packets and AO streams; the same image as with AO bundles and
+  // as the scalar binary BVH tracing every ray alone. --simd off alone asks for that scalar tree.
   const std::string common = " -q --integrator ao --width 24 --height 20 --ao 4";
   auto r = test::run_tracer("render" + common + " --stats-json " + dir_ + "/d.json -o " + dir_ + "/d.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -589,9 +592,13 @@ TEST_F(Cli, DefaultIsTheFastestPathWithTheScalarImage) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["accel"].get<std::string>().rfind("bvh8", 0), 0u) << j.dump();
   EXPECT_TRUE(j["packets"].get<bool>());
+  EXPECT_TRUE(j["streams"].get<bool>());
   r = test::run_tracer("render" + common + " --accel bvh --no-packets -o " + dir_ + "/s.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_image(dir_ + "/d.png").rgb, read_image(dir_ + "/s.png").rgb);
+  r = test::run_tracer("render" + common + " --no-streams -o " + dir_ + "/b.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/d.png").rgb, read_image(dir_ + "/b.png").rgb);
   r = test::run_tracer("render" + common + " --simd off --stats-json " + dir_ + "/o.json -o " + dir_ + "/o.png");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in2(dir_ + "/o.json");

@@ -21,10 +21,11 @@ struct Rendered {
   RayCounts counts;
 };
 
-Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size,
-                     bool packets = false) {
+Rendered render_with(const Scene& scene, const Accelerator& acc, const SchedOptions& so, int size, bool packets = false,
+                     bool streams = false) {
   RenderSettings s;
   s.packets = packets;
+  s.streams = streams;
   s.width = size;
   s.height = size * 3 / 4 + 1;  // not a multiple of any tile size
   s.ao_samples = 4;
@@ -94,9 +95,10 @@ TEST(Sched, ImagesIdenticalAcrossSchedulersThreadsAndTiles) {
 }
 
 TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
-  // The 8-wide BVH with and without packets (primary rays in 4x4 packets, AO rays in bundles),
-  // and the binary BVH with AO bundles, against the scalar BVH's image; tile sizes not a
-  // multiple of the 4x4 packet leave partial packets at every tile's edge.
+  // The 8-wide BVH with and without packets (primary rays in 4x4 packets, AO rays in bundles or
+  // in sorted streams per 16x16 chunk), and the binary BVH with AO bundles, against the scalar
+  // BVH's image; tile sizes not a multiple of the 4x4 packet leave partial packets at every
+  // tile's edge, and tiles of 7 and 37 pixels partial stream chunks.
   const int size = int(test::ray_budget(100'000) >= 100'000 ? 48 : 24);
   for (const Scene& scene : scenes()) {
     SCOPED_TRACE(scene.source);
@@ -107,16 +109,17 @@ TEST(Sched, PacketsAndTheWideBvhGiveTheSameImageOnEveryScheduler) {
     const Accelerator wide = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh8});
     const Accelerator binary = build_accelerator(scene, AccelOptions{.kind = AccelKind::Bvh});
     for (Strategy kind : {Strategy::Seq, Strategy::Async, Strategy::Queue, Strategy::Atomic, Strategy::Tbb}) {
-      for (const int variant : {0, 1, 2}) {
-        const bool packets = variant > 0;
+      for (const int variant : {0, 1, 2, 3, 4}) {
+        const bool packets = variant > 0, streams = variant >= 3;
         SchedOptions so;
         so.strategy = kind;
-        so.threads = 2;
-        so.tile = 7;
+        so.threads = variant == 4 ? 1 : 2;
+        so.tile = variant == 4 ? 37 : 7;
         so.block = 30;
-        static const char* names[] = {" bvh8 single rays", " bvh8 packets", " bvh bundles"};
+        static const char* names[] = {" bvh8 single rays", " bvh8 packets", " bvh bundles", " bvh8 streams",
+                                      " bvh8 streams, 1 thread, tile 37"};
         SCOPED_TRACE(std::string(name_of<Strategy>(kStrategyNames, kind)) + names[variant]);
-        const Rendered r = render_with(scene, variant == 2 ? binary : wide, so, size, packets);
+        const Rendered r = render_with(scene, variant == 2 ? binary : wide, so, size, packets, streams);
         EXPECT_EQ(r.rgb, reference.rgb);
         EXPECT_EQ(r.counts.total(), reference.counts.total());
       }
@@ -201,8 +204,8 @@ TEST(Sched, CancelStopsEarlyAndLeavesRestUntouched) {
 
 TEST(Sched, EmbreePacketsTraceTheSameRaysAsEmbreeSingleRays) {
   // Embree's packet API (rtcIntersect16 per 4x4 block, rtcOccluded16 for its shadow rays and each
-  // hit's AO rays) against its single-ray API: the same rays, counted alike. Embree's packet and
-  // single-ray kernels are not bit-exact with each other (one byte of 48x37x3 differs on Sphere),
+  // hit's AO rays, or its stream API for the AO rays) against its single-ray API: the same rays, counted alike.
+  // Embree's packet and single-ray kernels are not bit-exact with each other (one byte of 48x37x3 differs on Sphere),
   // so the images must agree to within 50 dB rather than byte for byte.
   if (!embree_available()) GTEST_SKIP() << "no Embree in this build";
   const int size = int(test::ray_budget(100'000) >= 100'000 ? 48 : 24);
@@ -213,12 +216,15 @@ TEST(Sched, EmbreePacketsTraceTheSameRaysAsEmbreeSingleRays) {
     so.threads = 2;
     so.tile = 7;
     const Rendered single = render_with(scene, embree, so, size);
-    const Rendered packets = render_with(scene, embree, so, size, true);
-    EXPECT_EQ(packets.counts.primary, single.counts.primary);
-    EXPECT_EQ(packets.counts.shadow, single.counts.shadow);
-    EXPECT_EQ(packets.counts.ao, single.counts.ao);
-    Image8 a{size, size * 3 / 4 + 1, single.rgb}, b{size, size * 3 / 4 + 1, packets.rgb};
-    EXPECT_GE(test::psnr(a, b), 50.0);
+    for (const bool streams : {false, true}) {  // AO rays by rtcOccluded16 per hit, or rtcOccluded1M
+      SCOPED_TRACE(streams ? "streams" : "packets");
+      const Rendered packets = render_with(scene, embree, so, size, true, streams);
+      EXPECT_EQ(packets.counts.primary, single.counts.primary);
+      EXPECT_EQ(packets.counts.shadow, single.counts.shadow);
+      EXPECT_EQ(packets.counts.ao, single.counts.ao);
+      Image8 a{size, size * 3 / 4 + 1, single.rgb}, b{size, size * 3 / 4 + 1, packets.rgb};
+      EXPECT_GE(test::psnr(a, b), 50.0);
+    }
   }
 }
 

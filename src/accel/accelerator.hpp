@@ -104,6 +104,9 @@ inline bool traces_rays_together(AccelKind kind) {
   return kind == AccelKind::Bvh || kind == AccelKind::Bvh8 || is_embree(kind);
 }
 
+// Whether `kind` traces a sorted stream of occlusion rays at once (render/stream_order.hpp).
+inline bool traces_streams(AccelKind kind) { return kind == AccelKind::Bvh8 || is_embree(kind); }
+
 // Whether `kind` traces an instanced scene as instances (a two-level tree); a scene loaded for
 // the others has its instances expanded.
 inline bool traces_instances(AccelKind kind) { return kind == AccelKind::Bvh8 || is_embree(kind); }

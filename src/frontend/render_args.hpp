@@ -57,6 +57,7 @@ struct RenderArgs {
   std::optional<AccelKind> accel;             // empty: the library's default (scalar bvh with --simd off)
   std::optional<BuildQuality> build_quality;  // empty: chosen by the work (default_build_quality)
   std::optional<bool> packets;                // --packets / --no-packets; empty: where the accelerator can
+  std::optional<bool> streams;                // --streams / --no-streams; empty: where the accelerator can
   // path for a user's render (every material, soft shadows, indirect light); the library's
   // default, and bench's, stays the study's ao.
   Integrator integrator = Integrator::Path;

@@ -23,6 +23,7 @@ RenderSettings settings_for(const RenderArgs& a) {
   // and not for whitted or path, whose rays go one at a time.
   const bool together = a.packets.value_or(s.packets && a.simd != SimdUse::Off);
   s.packets = together && traces_rays_together(accel_options_for(a).kind) && s.integrator == Integrator::Ao;
+  s.streams = s.packets && a.streams.value_or(s.streams) && traces_streams(accel_options_for(a).kind);
   s.count_traversal = a.count;
   return s;
 }
@@ -30,6 +31,8 @@ RenderSettings settings_for(const RenderArgs& a) {
 RenderSettings settings_for(const RenderArgs& a, const Scene& scene, std::string& note) {
   RenderSettings s = settings_for(a);
   note.clear();
+  // The two-level tree (bvh8 on an instanced scene) traces AO rays in bundles: it has no stream kernel.
+  if (scene.instanced() && accel_options_for(a).kind == AccelKind::Bvh8) s.streams = false;
   if (s.integrator == Integrator::Path && !a.env && scene.environment_map.empty() && scene.emitters.empty()) {
     s.environment = Vec3{1.0f};
     note = scene.source +

@@ -58,6 +58,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
                       {"ao_samples", settings.ao_samples},
                       {"accel", accel.name},
                       {"packets", settings.packets},
+                      {"streams", settings.streams},
                       {"sched", name_of<Strategy>(kStrategyNames, sched.strategy)},
                       {"threads", thread_count(sched)},
                       {"load_ms", load_ms},
@@ -122,10 +123,15 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("lighting     %s\n", str("lighting").c_str());
   std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
               double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
-              !j["packets"].get<bool>()       ? ""
-              : accel.kind == AccelKind::Bvh8 ? ", primary rays in 4x4 packets, AO rays in bundles"
-              : is_embree(accel.kind)         ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16"
-                                              : ", AO rays in bundles");
+              !j["packets"].get<bool>() ? ""
+              : accel.kind == AccelKind::Bvh8
+                  ? (j["streams"].get<bool>() ? ", primary rays in 4x4 packets, AO rays in sorted streams"
+                                              : ", primary rays in 4x4 packets, AO rays in bundles")
+              : is_embree(accel.kind)
+                  ? (j["streams"].get<bool>() ? ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16 for shadow "
+                                                "rays, rtcOccluded1M for sorted AO streams"
+                                              : ", packet API: rtcIntersect16 per 4x4 block, rtcOccluded16")
+                  : ", AO rays in bundles");
   std::printf("memory       %.1f MiB accelerator, %.1f MiB peak resident (scene, accelerator, image)\n",
               double(j["accel_bytes"].get<size_t>()) / (1024.0 * 1024.0), j["peak_rss_mib"].get<double>());
   if (const std::optional<BvhStats> st = accel.bvh_stats()) {

@@ -287,6 +287,20 @@ std::vector<Setting> make_table() {
        .role = Role::Local,
        .excludes = "--packets"},
       [](RenderArgs & a) -> auto& { return a.packets; }, false));
+  t.push_back(tristate(
+      {.names = "--streams",
+       .help = "with packets, trace each tile's AO rays as sorted streams (bvh8, embree: rtcOccluded1M); same image "
+               "(default: on where the accelerator can)",
+       .applies = kAo,
+       .role = Role::Local},
+      [](RenderArgs & a) -> auto& { return a.streams; }, true));
+  t.push_back(tristate(
+      {.names = "--no-streams",
+       .help = "with packets, trace each hit's AO rays as one bundle instead (same image)",
+       .applies = kAo,
+       .role = Role::Local,
+       .excludes = "--streams"},
+      [](RenderArgs & a) -> auto& { return a.streams; }, false));
   t.push_back(row<std::optional<int>>(
       {.names = "--threads", .help = "worker threads (default: all hardware threads)", .role = Role::Local},
       [](RenderArgs & a) -> auto& { return a.threads; }, whole<int>(1, 1024)));

@@ -41,6 +41,12 @@ void check_combinations(const RenderArgs& a) {
   if (a.packets == true && !traces_rays_together(accel.kind)) {
     throw UsageError("--packets: needs --accel bvh, bvh8 or embree (the accelerators with packet kernels)");
   }
+  if (a.streams == true && (a.packets == false || a.simd == SimdUse::Off)) {
+    throw UsageError("--streams: traces rays together, which --no-packets and --simd off turn off");
+  }
+  if (a.streams == true && !traces_streams(accel.kind)) {
+    throw UsageError("--streams: needs --accel bvh8 or embree (the accelerators with stream kernels)");
+  }
   if (a.count && accel.kind != AccelKind::Bvh8) {
     throw UsageError("--count: only the 8-wide BVH counts its traversal (--accel bvh8, the default)");
   }

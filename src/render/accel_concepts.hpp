@@ -8,6 +8,7 @@
 #include "accel/kernels/traversal_counts.hpp"
 #include "math/ray.hpp"
 #include "math/ray_packet.hpp"
+#include "math/ray_stream.hpp"
 
 namespace tracer {
 
@@ -21,6 +22,13 @@ concept PacketAccelerator = requires(const A& a, const RayPacket& p, Hit* h) {
 template <class A>
 concept BundleAccelerator = requires(const A& a, const RayBundle& b) {
   a.occluded_bundle_from(b, 0u);
+};
+
+// Accelerators that answer a sorted stream of occlusion rays (a tile's AO rays) at once: the
+// 8-wide BVH's packets over the stream, Embree's stream API.
+template <class A>
+concept StreamAccelerator = requires(const A& a, const RayStream& s, StreamMask& m) {
+  a.occluded_stream(s, m);
 };
 
 // An occlusion query for a ray leaving scene triangle `origin`: accelerators that can start the
@@ -61,6 +69,9 @@ class Counted {
   }
   uint32_t occluded_bundle_from(const RayBundle& b, uint32_t origin) const requires BundleAccelerator<A> {
     return accel_->occluded_bundle_from(b, origin, counts_->any);
+  }
+  void occluded_stream(const RayStream& s, StreamMask& m) const requires StreamAccelerator<A> {
+    accel_->occluded_stream(s, m, counts_->any);
   }
 
  private:

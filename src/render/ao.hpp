@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include "math/rng.hpp"
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
+#include "render/stream_order.hpp"
 
 namespace tracer {
 
@@ -25,23 +27,33 @@ inline Vec3 ao_direction(Vec3 n, float r1, float r2) {
   return dot(d, n) < 0.0f ? -d : d;
 }
 
+// AO ray i of sample `sample` of pixel (x, y), leaving `si`. Sample k of the pixel takes AO rays
+// k * ao_samples ... of its stream: distinct per sample, and sample 0's are the one-sample image's.
+inline Ray ao_ray(const RenderSettings& s, int x, int y, const SurfaceInteraction& si, uint32_t sample, int i) {
+  const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
+  const SampleRng rng(pixel, sample * uint32_t(s.ao_samples) + uint32_t(i), s.seed);
+  Ray ao;
+  ao.org = si.origin;
+  ao.dir = ao_direction(si.n, rng.draw(0), rng.draw(1));
+  ao.tfar = s.ao_distance;
+  return ao;
+}
+
+// `direct` plus the ambient term scaled by the fraction of si's AO rays that escape (`open` of
+// ao_samples; all of them without AO).
+inline Vec3 with_ambient(const RenderSettings& s, const SurfaceInteraction& si, Vec3 direct, int open) {
+  const float unoccluded = s.ao_samples > 0 ? float(open) / float(s.ao_samples) : 1.0f;
+  return direct + si.mat->kd * (s.ambient * unoccluded);
+}
+
 // `direct` (the hit's emission and lamp light) plus the ambient term, scaled by the fraction of
 // `si`'s AO rays that escape: the pixel's colour.
 template <class Accel>
 Vec3 finish_with_ambient(const Accel& accel, const PassContext& ctx, int x, int y, const SurfaceInteraction& si,
                          Vec3 direct, RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
-  float unoccluded = 1.0f;
+  int open = 0;
   if (s.ao_samples > 0) {
-    const uint32_t pixel = uint32_t(y) * uint32_t(s.width) + uint32_t(x);
-    // Sample k of the pixel takes AO rays k * ao_samples ... of its stream: distinct per sample,
-    // and sample 0's are the one-sample image's.
-    const uint32_t first_ray = sample * uint32_t(s.ao_samples);
-    const auto direction = [&](int i) {
-      const SampleRng rng(pixel, first_ray + uint32_t(i), s.seed);
-      return ao_direction(si.n, rng.draw(0), rng.draw(1));
-    };
-    int open = 0;
     bool bundled = false;
     if constexpr (BundleAccelerator<Accel>) {
       if (s.packets) {
@@ -51,25 +63,19 @@ Vec3 finish_with_ambient(const Accel& accel, const PassContext& ctx, int x, int 
           bundle.org = si.origin;
           bundle.tfar = s.ao_distance;
           const int count = std::min(kPacketSize, s.ao_samples - first);
-          for (int k = 0; k < count; ++k) bundle.set_direction(k, direction(first + k));
+          for (int k = 0; k < count; ++k) bundle.set_direction(k, ao_ray(s, x, y, si, sample, first + k).dir);
           open += count - std::popcount(accel.occluded_bundle_from(bundle, si.tri));
         }
         bundled = true;
       }
     }
     if (!bundled) {
-      for (int i = 0; i < s.ao_samples; ++i) {
-        Ray ao;
-        ao.org = si.origin;
-        ao.dir = direction(i);
-        ao.tfar = s.ao_distance;
-        open += occluded_leaving(accel, ao, si.tri) ? 0 : 1;
-      }
+      for (int i = 0; i < s.ao_samples; ++i)
+        open += occluded_leaving(accel, ao_ray(s, x, y, si, sample, i), si.tri) ? 0 : 1;
     }
     counts.ao += uint64_t(s.ao_samples);
-    unoccluded = float(open) / float(s.ao_samples);
   }
-  return direct + si.mat->kd * (s.ambient * unoccluded);
+  return with_ambient(s, si, direct, open);
 }
 
 // The colour of pixel (x, y) whose primary ray `primary` found `hit` (invalid: nothing).
@@ -97,13 +103,14 @@ struct AoIntegrator {
     return shade_hit(accel, ctx, ps.x, ps.y, ps.ray, hit, counts, ps.index);
   }
 
+  // The primary rays of `block` as one packet and the direct light at their hits: radiance[k] of
+  // each active lane (black where it escapes), sis[k] and bit k of the returned mask where it hit.
   template <class Accel>
   requires PacketAccelerator<Accel>
-  void block_radiance(const Accel& accel, const PassContext& ctx, const PixelBlock& block, Vec3* radiance,
-                      RayCounts& counts) const {
+  static uint32_t block_direct(const Accel& accel, const PassContext& ctx, const PixelBlock& block, Vec3* radiance,
+                               SurfaceInteraction* sis, RayCounts& counts) {
     Hit hits[kPacketSize];
     accel.intersect_packet(block.packet, hits);
-    SurfaceInteraction sis[kPacketSize];
     uint32_t lit = 0;  // lanes that hit something
     for (uint32_t bits = block.packet.active; bits; bits &= bits - 1) {
       const int k = std::countr_zero(bits);
@@ -114,10 +121,73 @@ struct AoIntegrator {
       lit |= 1u << k;
     }
     add_lamp_light(accel, ctx, sis, lit, radiance, counts);
+    return lit;
+  }
+
+  template <class Accel>
+  requires PacketAccelerator<Accel>
+  void block_radiance(const Accel& accel, const PassContext& ctx, const PixelBlock& block, Vec3* radiance,
+                      RayCounts& counts) const {
+    SurfaceInteraction sis[kPacketSize];
+    const uint32_t lit = block_direct(accel, ctx, block, radiance, sis, counts);
     for (uint32_t bits = lit; bits; bits &= bits - 1) {
       const int k = std::countr_zero(bits);
       radiance[k] = finish_with_ambient(accel, ctx, block.x(k), block.y(k), sis[k], radiance[k], counts);
     }
+  }
+
+  // A chunk of up to 16x16 pixels' centred samples as a stream (render/stream_order.hpp): the
+  // primary rays and shadow rays by 4x4 blocks as block_radiance() traces them, then every hit's
+  // AO rays gathered into one stream, sorted, traced by the accelerator's stream kernel and
+  // counted back per pixel. Each ray gets the answer it gets alone and a pixel's colour depends
+  // only on how many of its rays escape, so the colours are those radiance() gives.
+  template <class Accel>
+  requires PacketAccelerator<Accel> && StreamAccelerator<Accel>
+  void chunk_radiance(const Accel& accel, const PassContext& ctx, const PixelChunk& chunk, Vec3* radiance,
+                      RayCounts& counts) const {
+    const RenderSettings& s = ctx.settings;
+    SurfaceInteraction sis[kChunkPixels];
+    int open[kChunkPixels] = {};
+    std::array<uint32_t, kChunkPixels / 32> lit{};
+    for (int by = chunk.y0; by < chunk.y1; by += kPacketEdge) {
+      for (int bx = chunk.x0; bx < chunk.x1; bx += kPacketEdge) {
+        const PixelBlock block = primary_block(ctx, bx, by, chunk.x1, chunk.y1);
+        counts.primary += uint64_t(std::popcount(block.packet.active));
+        Vec3 direct[kPacketSize];
+        SurfaceInteraction block_sis[kPacketSize];
+        const uint32_t block_lit = block_direct(accel, ctx, block, direct, block_sis, counts);
+        for (uint32_t bits = block.packet.active; bits; bits &= bits - 1) {
+          const int k = std::countr_zero(bits);
+          const int p = chunk.index(block.x(k), block.y(k));
+          radiance[p] = direct[k];
+          if (!(block_lit >> k & 1u)) continue;
+          sis[p] = block_sis[k];
+          lit[size_t(p) / 32] |= 1u << (p % 32);
+        }
+      }
+    }
+    if (s.ao_samples > 0) {
+      static thread_local RayStream stream;  // 160 KB: kept per thread, not on the stack
+      stream.size = 0;
+      const auto flush = [&] {
+        sort_stream(stream);
+        StreamMask occluded;
+        accel.occluded_stream(stream, occluded);
+        for (uint32_t i = 0; i < stream.size; ++i) open[stream.owner[i]] += occluded.test(i) ? 0 : 1;
+        stream.size = 0;
+      };
+      for (int p = 0; p < kChunkPixels; ++p) {
+        if (!(lit[size_t(p) / 32] >> (p % 32) & 1u)) continue;
+        for (int i = 0; i < s.ao_samples; ++i) {
+          if (stream.full()) flush();
+          stream.push(ao_ray(s, chunk.x(p), chunk.y(p), sis[p], 0, i), uint16_t(p));
+        }
+        counts.ao += uint64_t(s.ao_samples);
+      }
+      if (stream.size > 0) flush();
+    }
+    for (int p = 0; p < kChunkPixels; ++p)
+      if (lit[size_t(p) / 32] >> (p % 32) & 1u) radiance[p] = with_ambient(s, sis[p], radiance[p], open[p]);
   }
 };
 

@@ -5,6 +5,7 @@
 // seed), so passes, tiles, threads and schedulers add up to the same image.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <concepts>
@@ -89,6 +90,31 @@ struct PixelBlock {
   int y(int lane) const { return y0 + lane / kPacketEdge; }
 };
 
+// Builds the block at (bx, by) with the camera rays of its pixels left of x1 and above y1.
+inline PixelBlock primary_block(const PassContext& ctx, int bx, int by, int x1, int y1) {
+  PixelBlock block;
+  block.x0 = bx;
+  block.y0 = by;
+  for (int k = 0; k < kPacketSize; ++k) {
+    if (block.x(k) >= x1 || block.y(k) >= y1) continue;
+    block.rays[k] = ctx.camera.primary_ray(block.x(k), block.y(k));
+    block.packet.set(k, block.rays[k]);
+  }
+  return block;
+}
+
+// Up to 16x16 pixels of a tile whose centred samples' AO rays are traced as one stream: 16 AO
+// rays per pixel fill a RayStream. Pixel p of the chunk is (x0 + p % 16, y0 + p / 16).
+inline constexpr int kChunkEdge = 16;
+inline constexpr int kChunkPixels = kChunkEdge * kChunkEdge;
+struct PixelChunk {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // x1, y1 exclusive, at most kChunkEdge past x0, y0
+  int index(int x, int y) const { return (y - y0) * kChunkEdge + (x - x0); }
+  int x(int p) const { return x0 + p % kChunkEdge; }
+  int y(int p) const { return y0 + p / kChunkEdge; }
+  bool contains(int p) const { return x(p) < x1 && y(p) < y1; }
+};
+
 // An integrator: its sample streams and the radiance along a sample's camera ray. `first` and
 // `guide`, when not null, take what the --aov layers and the denoiser read of the sample.
 template <class I, class Accel>
@@ -105,6 +131,15 @@ concept BlockIntegrator = PixelIntegrator<I, Accel> &&
   i.block_radiance(accel, ctx, block, radiance, counts);
 };
 
+// One that also shades a chunk's centred samples with their AO rays as one stream (--streams):
+// radiance[p] of each pixel p of the chunk, each what radiance() gives that pixel.
+template <class I, class Accel>
+concept ChunkIntegrator = BlockIntegrator<I, Accel> &&
+    requires(const I& i, const Accel& accel, const PassContext& ctx, const PixelChunk& chunk, Vec3* radiance,
+             RayCounts& counts) {
+  i.chunk_radiance(accel, ctx, chunk, radiance, counts);
+};
+
 // Adds this pass's samples (ctx.samples) of every pixel of `tile` (those ctx.active keeps) to the
 // films: each pixel's sum taken in sample order from zero (see Framebuffer). A sample that comes
 // out non-finite (a float overflow on a degenerate path) adds black rather than poisoning it.
@@ -118,16 +153,23 @@ void render_pixels(const Integrator& integrator, const Accel& accel, const PassC
   const bool centred = Streams::kCentredSingleSample && s.spp == 1 && !lens;
   if constexpr (BlockIntegrator<Integrator, Accel>) {
     if (centred && s.packets) {
+      if constexpr (ChunkIntegrator<Integrator, Accel>) {
+        if (s.streams) {
+          for (int cy = tile.y0; cy < tile.y1; cy += kChunkEdge) {
+            for (int cx = tile.x0; cx < tile.x1; cx += kChunkEdge) {
+              const PixelChunk chunk{cx, cy, std::min(cx + kChunkEdge, tile.x1), std::min(cy + kChunkEdge, tile.y1)};
+              Vec3 radiance[kChunkPixels];
+              integrator.chunk_radiance(accel, ctx, chunk, radiance, counts);
+              for (int p = 0; p < kChunkPixels; ++p)
+                if (chunk.contains(p)) ctx.framebuffer->add(chunk.x(p), chunk.y(p), radiance[p]);
+            }
+          }
+          return;
+        }
+      }
       for (int by = tile.y0; by < tile.y1; by += kPacketEdge) {
         for (int bx = tile.x0; bx < tile.x1; bx += kPacketEdge) {
-          PixelBlock block;
-          block.x0 = bx;
-          block.y0 = by;
-          for (int k = 0; k < kPacketSize; ++k) {
-            if (block.x(k) >= tile.x1 || block.y(k) >= tile.y1) continue;
-            block.rays[k] = ctx.camera.primary_ray(block.x(k), block.y(k));
-            block.packet.set(k, block.rays[k]);
-          }
+          const PixelBlock block = primary_block(ctx, bx, by, tile.x1, tile.y1);
           counts.primary += uint64_t(std::popcount(block.packet.active));
           Vec3 radiance[kPacketSize];
           integrator.block_radiance(accel, ctx, block, radiance, counts);

@@ -23,15 +23,16 @@ void choose_active_pixels(PassContext& ctx, RenderMonitor& control) {
 }
 
 TileResult render_tile_of(const Accelerator& accel, const PassContext& ctx, const Tile& tile, CancelFlag cancel) {
-  // The tile is walked in pieces of kPieceWidth x kPacketEdge pixels (aligned to the tile, so
-  // packet blocks are the same) with the cancel flag checked between them: a whole-row tile of
-  // the async and seq schedulers or a --tile 4096 stops within moments of a Ctrl-C.
+  // The tile is walked in pieces of kPieceWidth x kChunkEdge pixels (aligned to the tile, so
+  // packet blocks and stream chunks are the same) with the cancel flag checked between them: a
+  // whole-row tile of the async and seq schedulers or a --tile 4096 stops within moments of a
+  // Ctrl-C.
   constexpr int kPieceWidth = 64;
   TileResult result;
   const auto pieces = [&](const auto& a) {
-    for (int y = tile.y0; y < tile.y1 && !is_cancelled(cancel); y += kPacketEdge) {
+    for (int y = tile.y0; y < tile.y1 && !is_cancelled(cancel); y += kChunkEdge) {
       for (int x = tile.x0; x < tile.x1 && !is_cancelled(cancel); x += kPieceWidth) {
-        const Tile piece{x, y, std::min(x + kPieceWidth, tile.x1), std::min(y + kPacketEdge, tile.y1)};
+        const Tile piece{x, y, std::min(x + kPieceWidth, tile.x1), std::min(y + kChunkEdge, tile.y1)};
         result.rays += render_tile(a, ctx, piece);
         result.pixels += uint64_t(piece.pixel_count());
       }

@@ -43,6 +43,9 @@ struct RenderSettings {
   // Trace rays together where the accelerator can (primary rays in 4x4-pixel packets, a block's
   // shadow rays, each hit's AO rays as one bundle): the same image, faster.
   bool packets = true;
+  // With packets: each tile's AO rays gathered into streams, sorted by direction and origin and
+  // traced together where the accelerator takes streams (render/stream_order.hpp): the same image.
+  bool streams = true;
   // Count the nodes, leaf packs and triangles each query visits (--count; accelerators that can:
   // the 8-wide BVH): the same image, rendered through counting kernels.
   bool count_traversal = false;
