@@ -41,6 +41,10 @@ const std::vector<Variant>& all_variants() {
        "8-wide SIMD BVH (TBB build), TBB work stealing", false},
       {"best", AccelKind::Bvh8, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
        "8-wide SIMD BVH (TBB build), primary-ray packets and AO bundles, TBB work stealing", false, true},
+      {"best-streams", AccelKind::Bvh8, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
+       "8-wide SIMD BVH (TBB build), primary-ray packets, AO rays in sorted streams per 16x16 pixels, TBB work "
+       "stealing",
+       false, true, BuildQuality::Medium, true},
       {"bvh8-high", AccelKind::Bvh8, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
        "8-wide SIMD BVH at high build quality (spatial splits), TBB work stealing", false, false, BuildQuality::High},
       {"best-high", AccelKind::Bvh8, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
@@ -52,6 +56,10 @@ const std::vector<Variant>& all_variants() {
        "Intel Embree 3, packets: rtcIntersect16 per 4x4 block, rtcOccluded16 for its shadow rays and for each hit's "
        "AO rays, TBB work stealing",
        false, true},
+      {"embree-streams", AccelKind::Embree, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
+       "Intel Embree 3, packets as embree-packets, but AO rays as the same sorted streams best-streams traces, by "
+       "rtcOccluded1M (coherent), TBB work stealing",
+       false, true, BuildQuality::Medium, true},
       {"embree-high", AccelKind::EmbreeHigh, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,
        "Intel Embree 3 at its HIGH build quality (spatial splits), single rays, TBB work stealing", false},
       {"embree-high-packets", AccelKind::EmbreeHigh, BvhSplit::Sah, Strategy::Tbb, Strategy::Tbb,

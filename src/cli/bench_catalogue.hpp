@@ -24,6 +24,7 @@ struct Variant {
   bool study;
   bool packets = false;                         // primary rays in 4x4 packets (bvh8), AO rays in bundles (bvh, bvh8)
   BuildQuality quality = BuildQuality::Medium;  // bvh8 (Embree's is in its AccelKind)
+  bool streams = false;                         // with packets: AO rays in sorted streams per 16x16 pixels
 };
 
 // The study's ten columns (its ISPC column is simd-brute, our Highway kernels) and ours.

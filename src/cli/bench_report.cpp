@@ -93,6 +93,7 @@ std::string markdown_tables(const BenchReport& r) {
   }
   for (const auto& [reference_name, title] : {std::pair<std::string, std::string>{"embree", "Embree's single rays"},
                                               {"embree-packets", "Embree's packet API"},
+                                              {"embree-streams", "Embree's stream API on the same sorted AO rays"},
                                               {"embree-high", "Embree's single rays at HIGH build quality"},
                                               {"embree-high-packets", "Embree's packet API at HIGH build quality"}}) {
     // A plain reference: clang 14 cannot capture a structured binding in a lambda.

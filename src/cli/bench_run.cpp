@@ -78,6 +78,7 @@ Cell run_cell(const CellJob& job, const std::function<void(int)>& on_run) {
     rs.integrator = job.integrator;
     rs.spp = job.integrator == Integrator::Path ? job.spp : 1;
     rs.packets = v.packets && job.integrator == Integrator::Ao;
+    rs.streams = rs.packets && v.streams;
     Framebuffer fb(job.width, job.height);
     PassContext ctx{&job.scene, Camera(job.camera, job.width, job.height), rs, &fb};
     ctx.samples = {0, uint32_t(rs.spp)};  // one pass: the timing has no pass overhead
