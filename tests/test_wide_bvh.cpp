@@ -656,6 +656,27 @@ size_t bundle_disagreements(const A& accel, const std::vector<BundleCase>& cases
   return bad;
 }
 
+// One bundle of `lanes` rays above each vertex and edge midpoint of the box's axis-aligned walls
+// and spheres: lane 0 straight down through the point (edge functions exactly zero, decided in
+// double), the others spread below it.
+std::vector<BundleCase> vertex_and_edge_cases(const Scene& scene, int lanes, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  std::vector<BundleCase> cases;
+  for (uint32_t i = 0; i < scene.size(); ++i) {
+    const Triangle& t = scene.triangles[i];
+    for (const Vec3& v : {t.v0, t.v1, t.v2, (t.v0 + t.v1) * 0.5f}) {
+      BundleCase c;
+      c.rays.org = {v.x, scene.bounds.hi.y + 1.0f, v.z};
+      c.rays.set_direction(0, {0, -1, 0});
+      for (int k = 1; k < lanes; ++k) c.rays.set_direction(k, ao_direction({0, -1, 0}, u01(rng), u01(rng)));
+      c.origin = i;
+      cases.push_back(c);
+    }
+  }
+  return cases;
+}
+
 TEST(RayBundles, SameAnswersAsSingleRaysOnEveryTarget) {
   for_each_target_and_scene([](const Scene& scene, SimdTarget target) {
     const std::vector<BundleCase> cases = bundles_for(scene, test::ray_budget(20'000) / kPacketSize, 17);
@@ -667,24 +688,8 @@ TEST(RayBundles, SameAnswersAsSingleRaysOnEveryTarget) {
 }
 
 TEST(RayBundles, RaysThroughVerticesAndEdges) {
-  // One bundle above each vertex and edge midpoint of the box's axis-aligned walls and spheres:
-  // lane 0 straight down through the point (edge functions exactly zero, decided in double),
-  // the others spread below it.
   const Scene scene = make_cornell_box(800);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
-  std::vector<BundleCase> cases;
-  for (uint32_t i = 0; i < scene.size(); ++i) {
-    const Triangle& t = scene.triangles[i];
-    for (const Vec3& v : {t.v0, t.v1, t.v2, (t.v0 + t.v1) * 0.5f}) {
-      BundleCase c;
-      c.rays.org = {v.x, scene.bounds.hi.y + 1.0f, v.z};
-      c.rays.set_direction(0, {0, -1, 0});
-      for (int k = 1; k < kPacketSize; ++k) c.rays.set_direction(k, ao_direction({0, -1, 0}, u01(rng), u01(rng)));
-      c.origin = i;
-      cases.push_back(c);
-    }
-  }
+  const std::vector<BundleCase> cases = vertex_and_edge_cases(scene, kPacketSize, 3);
   for (const SimdTarget target : targets()) {
     EXPECT_EQ(bundle_disagreements(Bvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh";
     EXPECT_EQ(bundle_disagreements(WideBvh(scene, for_target(target)), cases), 0u) << target_name(target) << " bvh8";
@@ -735,20 +740,7 @@ TEST(RayStreams, SameAnswersAsSingleRaysOnEveryTarget) {
 
 TEST(RayStreams, RaysThroughVerticesAndEdges) {
   const Scene scene = make_cornell_box(800);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
-  std::vector<BundleCase> cases;
-  for (uint32_t i = 0; i < scene.size(); ++i) {
-    const Triangle& t = scene.triangles[i];
-    for (const Vec3& v : {t.v0, t.v1, t.v2, (t.v0 + t.v1) * 0.5f}) {
-      BundleCase c;
-      c.rays.org = {v.x, scene.bounds.hi.y + 1.0f, v.z};
-      c.rays.set_direction(0, {0, -1, 0});
-      for (int k = 1; k < 4; ++k) c.rays.set_direction(k, ao_direction({0, -1, 0}, u01(rng), u01(rng)));
-      c.origin = i;
-      cases.push_back(c);
-    }
-  }
+  const std::vector<BundleCase> cases = vertex_and_edge_cases(scene, 4, 5);
   const auto streams = streams_of(cases);
   for (const SimdTarget target : targets())
     EXPECT_EQ(stream_disagreements(WideBvh(scene, for_target(target)), streams), 0u) << target_name(target);
@@ -780,6 +772,7 @@ TEST(RayStreams, TheSortIsAStablePermutationGroupedByShearClass) {
     if (i % 9 == 0) r.dir.y = 0.0f;
     if (i % 31 == 0) r.dir = {0.0f, i % 2 ? 1.0f : -1.0f, 0.0f};
     if (i == 100) r.dir = {0.0f, 0.0f, 0.0f};
+    if (i == 200) r.dir = {1e-45f, -1e-45f, 0.0f};  // denormal: the key's scale overflows to inf
     s->push(r, uint16_t(i % 256));
   }
   sort_stream(*s);

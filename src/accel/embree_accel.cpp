@@ -109,22 +109,33 @@ EmbreeAccel::~EmbreeAccel() {
   if (device_) rtcReleaseDevice(device_);
 }
 
+namespace {
+
+// `ray` as Embree's single ray, its id `id`.
+RTCRay rtc_ray(const Ray& ray, unsigned id) {
+  RTCRay r;
+  r.org_x = ray.org.x;
+  r.org_y = ray.org.y;
+  r.org_z = ray.org.z;
+  r.tnear = ray.tnear;
+  r.dir_x = ray.dir.x;
+  r.dir_y = ray.dir.y;
+  r.dir_z = ray.dir.z;
+  r.time = 0.0f;
+  r.tfar = ray.tfar;
+  r.mask = 0xffffffffu;
+  r.id = id;
+  r.flags = 0;
+  return r;
+}
+
+}  // namespace
+
 bool EmbreeAccel::intersect(const Ray& ray, Hit& hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  rh.ray.org_x = ray.org.x;
-  rh.ray.org_y = ray.org.y;
-  rh.ray.org_z = ray.org.z;
-  rh.ray.tnear = ray.tnear;
-  rh.ray.dir_x = ray.dir.x;
-  rh.ray.dir_y = ray.dir.y;
-  rh.ray.dir_z = ray.dir.z;
-  rh.ray.time = 0.0f;
-  rh.ray.tfar = ray.tfar;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
+  rh.ray = rtc_ray(ray, 0);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -141,19 +152,7 @@ bool EmbreeAccel::intersect(const Ray& ray, Hit& hit) const {
 bool EmbreeAccel::occluded(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay r;
-  r.org_x = ray.org.x;
-  r.org_y = ray.org.y;
-  r.org_z = ray.org.z;
-  r.tnear = ray.tnear;
-  r.dir_x = ray.dir.x;
-  r.dir_y = ray.dir.y;
-  r.dir_z = ray.dir.z;
-  r.time = 0.0f;
-  r.tfar = ray.tfar;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
+  RTCRay r = rtc_ray(ray, 0);
   rtcOccluded1(rtc_scene_, &context, &r);
   return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
@@ -267,20 +266,7 @@ void EmbreeAccel::occluded_stream(const RayStream& rays, StreamMask& occluded) c
   stream.resize(rays.size);
   for (uint32_t at = 0; at < rays.size; ++at) {
     const uint32_t i = rays.order[at];
-    const RayStream::Entry& e = rays.rays[i];
-    RTCRay& r = stream[at];
-    r.org_x = e.org.x;
-    r.org_y = e.org.y;
-    r.org_z = e.org.z;
-    r.tnear = e.tnear;
-    r.dir_x = e.dir.x;
-    r.dir_y = e.dir.y;
-    r.dir_z = e.dir.z;
-    r.time = 0.0f;
-    r.tfar = e.tfar;
-    r.mask = 0xffffffffu;
-    r.id = i;
-    r.flags = 0;
+    stream[at] = rtc_ray(rays.ray(i), i);
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

@@ -22,7 +22,7 @@ uint32_t stream_key(float dx, float dy, float dz) {
   const float scale = 8.0f / std::abs(c[kz]);
   const auto q = [&](float v) {
     const float f = v * scale + 8.0f;
-    return f > 0.0f ? std::min(uint32_t(f), 15u) : 0u;  // NaN (a zero direction): 0
+    return f > 0.0f ? uint32_t(std::min(f, 15.0f)) : 0u;  // NaN (a zero direction): 0; inf: 15
   };
   return (cls << 8) | (kSpread2[q(c[kx])] << 1) | kSpread2[q(c[ky])];
 }

@@ -74,6 +74,31 @@ HWY_INLINE uint32_t TestChildPacket(const WideNode& n, int c, const PacketState&
   return hits;
 }
 
+// Triangle `k` of `p`, its vertices along the packet's shear axes splatted once; sheared_for()
+// moves it to the origins of lanes i .. i + N and shears it by their directions.
+template <class V>
+struct PackTriangleLanes {
+  V ax, ay, az, bx, by, bz, cx, cy, cz;
+  template <class D>
+  HWY_INLINE PackTriangleLanes(D d, const TrianglePack& p, int k, const PacketState& st)
+      : ax(hn::Set(d, p.v[0][st.kx][k])),
+        ay(hn::Set(d, p.v[0][st.ky][k])),
+        az(hn::Set(d, p.v[0][st.kz][k])),
+        bx(hn::Set(d, p.v[1][st.kx][k])),
+        by(hn::Set(d, p.v[1][st.ky][k])),
+        bz(hn::Set(d, p.v[1][st.kz][k])),
+        cx(hn::Set(d, p.v[2][st.kx][k])),
+        cy(hn::Set(d, p.v[2][st.ky][k])),
+        cz(hn::Set(d, p.v[2][st.kz][k])) {}
+  template <class D>
+  HWY_INLINE ShearedTriangle<V> sheared_for(D d, const PacketState& st, size_t i) const {
+    using L = SimdLanes<D>;
+    const V okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
+    return shear_triangle<L>({ax - okx, ay - oky, az - okz}, {bx - okx, by - oky, bz - okz},
+                             {cx - okx, cy - oky, cz - okz}, hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
+  }
+};
+
 // Triangle `k` of `pack` against the lanes in `mask`, updating each lane's closest hit exactly
 // as intersect_range() does for one ray.
 HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Triangle* tris, PacketState& st,
@@ -84,17 +109,12 @@ HWY_INLINE void IntersectTrianglePacket(const TrianglePack& p, int k, const Tria
   const size_t N = hn::Lanes(d);
   const uint32_t tri = p.id[k];
   const int32_t id = int32_t(tri ^ uint32_t(kFlip));
-  const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
-  const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
-  const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
+  const PackTriangleLanes<L::V> t(d, p, k, st);
   const auto vid = hn::Set(di, id);
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
-    const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
-    const ShearedTriangle<L::V> s =
-        shear_triangle<L>({ax0 - okx, ay0 - oky, az0 - okz}, {bx0 - okx, by0 - oky, bz0 - okz},
-                          {cx0 - okx, cy0 - oky, cz0 - okz}, hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
+    const ShearedTriangle<L::V> s = t.sheared_for(d, st, i);
     const auto best_t = hn::Load(d, st.t + i);
     const auto best_id = hn::Load(di, st.tri + i);
     const TriangleLanes<L> found =

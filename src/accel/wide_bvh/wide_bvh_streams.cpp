@@ -31,17 +31,12 @@ HWY_INLINE uint32_t OccludedByTrianglePacket(const TrianglePack& p, int k, const
   const hn::ScalableTag<float> d;
   using L = SimdLanes<decltype(d)>;
   const size_t N = hn::Lanes(d);
-  const auto ax0 = hn::Set(d, p.v[0][st.kx][k]), ay0 = hn::Set(d, p.v[0][st.ky][k]), az0 = hn::Set(d, p.v[0][st.kz][k]);
-  const auto bx0 = hn::Set(d, p.v[1][st.kx][k]), by0 = hn::Set(d, p.v[1][st.ky][k]), bz0 = hn::Set(d, p.v[1][st.kz][k]);
-  const auto cx0 = hn::Set(d, p.v[2][st.kx][k]), cy0 = hn::Set(d, p.v[2][st.ky][k]), cz0 = hn::Set(d, p.v[2][st.kz][k]);
+  const PackTriangleLanes<L::V> t(d, p, k, st);
   uint32_t found = 0;
   for (size_t i = 0; i < size_t(kPacketSize); i += N) {
     const uint32_t chunk = ChunkBits(mask, i, N);
     if (chunk == 0) continue;
-    const auto okx = hn::Load(d, st.okx + i), oky = hn::Load(d, st.oky + i), okz = hn::Load(d, st.okz + i);
-    const ShearedTriangle<L::V> s =
-        shear_triangle<L>({ax0 - okx, ay0 - oky, az0 - okz}, {bx0 - okx, by0 - oky, bz0 - okz},
-                          {cx0 - okx, cy0 - oky, cz0 - okz}, hn::Load(d, st.sx + i), hn::Load(d, st.sy + i));
+    const ShearedTriangle<L::V> s = t.sheared_for(d, st, i);
     const auto on_edge = on_an_edge<L>(s);
     const auto outside = passes_outside<L>(s);
     const auto live = LaneMask(d, chunk);
