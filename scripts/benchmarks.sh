@@ -3,7 +3,7 @@
 # the study's table, the scheduler scaling at 1 and 2 threads, the per-task overhead, our variants
 # with Embree on all scenes, the Google Benchmark microbenchmarks, then path tracing beside Embree
 # (scripts/benchmarks-path.sh), tracer-mpi (scripts/benchmarks-mpi.sh) and the scaling from 100k to
-# 5M triangles (scripts/benchmarks-scale.sh), builds (scripts/benchmarks-build.sh), loading (scripts/benchmarks-load.sh), the viewer (scripts/benchmarks-view.sh). Outputs go to docs/bench/.
+# 5M triangles (scripts/benchmarks-scale.sh), builds (scripts/benchmarks-build.sh), loading (scripts/benchmarks-load.sh), the viewer (scripts/benchmarks-view.sh), ray streams (scripts/benchmarks-streams.sh). Outputs go to docs/bench/.
 # Run from the project root with ../shared/scenes beside it, on an otherwise idle machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -87,4 +87,6 @@ scripts/benchmarks-build.sh
 scripts/benchmarks-load.sh
 # 8. tracer view in the browser: move to frame, frames per second.
 scripts/benchmarks-view.sh
+# 9. Ray streams: the AO workload's rays sorted per 16x16 pixels, beside Embree's stream API.
+scripts/benchmarks-streams.sh
 echo "figures written to $O/"
