@@ -489,12 +489,14 @@ test::CommandResult stall_one_rank(const std::string& command, const std::string
       const auto [code, seconds] = wait_for(launcher);
       return {code, read_file(log)};
     }
-    // Rank 0 writes the image and aborts the job; the stopped rank can only die once continued.
+    // Rank 0 writes the image and aborts the job; the stopped rank is killed where it stands
+    // (SIGKILL ends a stopped process): continued first, it could run long enough to report rank
+    // 0's silence as a second error, as a loaded CI machine once let it.
     for (int i = 0; i < 900 && !(fs::exists(image) && pids_of_rank(0, dir).empty()); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
-    ::kill(victim, SIGCONT);
     ::kill(victim, SIGKILL);
+    ::kill(victim, SIGCONT);
   }
   const auto [code, seconds] = wait_for(launcher);
   return {code, read_file(log)};
