@@ -111,7 +111,7 @@ HWY_INLINE uint32_t OccludedPacketInTree(const WideBvh& bvh, const PacketState& 
 // tested first by the next group of the class (sorted, its rays point the same way from nearby
 // points, so they often hit the same wall); a class whose cache ended none of a group's rays
 // skips it for the next kCacheRest groups. It ends most of Sponza's AO rays before any node is
-// visited (4.89 nodes a ray to 1.44) and costs the Bunny's, which mostly escape, a pack a group
+// visited (4.89 nodes a ray to 1.49) and costs the Bunny's, which mostly escape, a pack a group
 // at most (docs/bench/LOG.md, session 30).
 constexpr int kCacheSlots = 2;
 constexpr int kCacheRest = 4;
