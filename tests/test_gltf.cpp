@@ -228,18 +228,22 @@ TEST(Gltf, HostileFilesFailWithOneLineNamingTheFile) {
     for (int i = 1; i < 40; ++i)
       g.extra_nodes += ", {\"mesh\": 0, \"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
     g.extra_nodes += R"(, {"mesh": 0})";
-    cases.push_back(
-        {"instances that expand without bound", g, "t.gltf: its nodes expand to more than 16777216 instances"});
+    cases.push_back({"instances that expand without bound", g,
+                     "t.gltf: its nodes, children of more than one parent, expand to more than 2097193 node instances, "
+                     "more than tracer walks"});
   }
   {
-    // The same with no mesh below the root: no triangles to count, but 2^40 nodes to walk.
+    // The same with a camera at the bottom and no mesh below the root: no memory to estimate,
+    // but 2^40 cameras to place.
     TinyGltf g;
+    g.extra = R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}], )";
     g.node = R"({"mesh": 0, "children": [1, 1]})";
     for (int i = 1; i < 40; ++i)
       g.extra_nodes += ", {\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
-    g.extra_nodes += R"(, {})";
-    cases.push_back(
-        {"empty nodes that expand without bound", g, "t.gltf: its nodes expand to more than 16777216 instances"});
+    g.extra_nodes += R"(, {"camera": 0})";
+    cases.push_back({"cameras that expand without bound", g,
+                     "t.gltf: its nodes, children of more than one parent, expand to more than 2097193 node "
+                     "instances, more than tracer walks"});
   }
   {
     TinyGltf g;
@@ -408,6 +412,17 @@ TEST(Gltf, InfoCountsEachNodeOnceAndAgreesWithTheLoad) {
   const auto counted = test::run_tracer("info " + dir + "/huge.gltf");
   EXPECT_EQ(counted.exit_code, 0) << counted.output;
   EXPECT_NE(counted.output.find("triangles   2199023255551 (0 degenerate)"), std::string::npos) << counted.output;
+  // A camera below them: info lists cameras where they are placed, and refuses 2^40 of them as a
+  // load does.
+  huge.extra = R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}], )";
+  huge.extra_nodes.replace(huge.extra_nodes.rfind(R"({"mesh": 0})"), std::string::npos, R"({"camera": 0})");
+  std::ofstream(dir + "/cameras.gltf") << huge.json();
+  const auto cameras = test::run_tracer("info " + dir + "/cameras.gltf");
+  EXPECT_EQ(cameras.exit_code, 1) << cameras.output;
+  EXPECT_NE(cameras.output.find("cameras.gltf: its nodes, children of more than one parent, expand to more than "
+                                "2097193 node instances"),
+            std::string::npos)
+      << cameras.output;
   fs::remove_all(dir);
 }
 
@@ -450,6 +465,19 @@ TEST(Gltf, InstancesAboveTheMemoryLimitAreRefusedBeforeExpanding) {
   const Scene kept = load_gltf_from_memory(g.json(), "t.gltf", {}, limits);
   EXPECT_EQ(kept.size(), 1u);
   EXPECT_EQ(kept.instances.size(), 1u << 20);
+}
+
+// Nodes whose subtrees hold no mesh, camera or light place nothing: they are not walked, however
+// many paths reach them (40 levels each naming the next twice: 2^40 paths).
+TEST(Gltf, SubtreesThatPlaceNothingAreNotWalked) {
+  TinyGltf g;
+  g.node = R"({"mesh": 0, "children": [1, 1]})";
+  for (int i = 1; i < 40; ++i)
+    g.extra_nodes += ", {\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}";
+  g.extra_nodes += R"(, {"translation": [1e300, 0, 0]})";  // not finite in a float; never applied
+  const Scene s = load_gltf_from_memory(g.json(), "t.gltf");
+  EXPECT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.cameras.size(), 0u);
 }
 
 TEST(Gltf, ExternalFilesMustLieInsideTheScenesFolder) {

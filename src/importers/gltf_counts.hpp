@@ -31,7 +31,7 @@ struct Summary {
   Placed placed;
   uint64_t vertices = 0, degenerate = 0, emissive = 0;
   Aabb box;
-  bool listed = false;  // holds a camera or a point light
+  uint64_t listed = 0;  // nodes walked to place its cameras and point lights (0: it holds none)
   void add(const Summary& o, const Affine& to) {
     placed.add(o.placed);
     vertices = std::min(vertices + o.vertices, kSaturated);
@@ -43,7 +43,7 @@ struct Summary {
             Vec3{c & 1 ? o.box.hi.x : o.box.lo.x, c & 2 ? o.box.hi.y : o.box.lo.y, c & 4 ? o.box.hi.z : o.box.lo.z}));
       }
     }
-    listed = listed || o.listed;
+    listed = std::min(listed + o.listed, kSaturated);
   }
 };
 

@@ -129,6 +129,7 @@ Vec3 vec3_of(const std::vector<double>& v, Vec3 fallback) {
 }
 
 const tg::Value* extension(const tg::ExtensionMap& map, const char* name) {
+  if (map.empty()) return nullptr;  // find() would build a std::string from name on every call
   const auto it = map.find(name);
   return it == map.end() ? nullptr : &it->second;
 }
