@@ -3,13 +3,16 @@
 
 #include <fstream>
 
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <numbers>
 
 #include "accel/accelerator.hpp"
+#include "accel/wide_bvh/wide_bvh.hpp"
 #include "io/image_io.hpp"
+#include "render/ao.hpp"
 #include "render/render_image.hpp"
 #include "render/render_tile.hpp"
 #include "scene/builtin.hpp"
@@ -151,6 +154,77 @@ TEST(Render, CountedTraversalChangesNoPixelAndCountsTheSameEverywhere) {
           if (!first_any.count(kind)) first_any[kind] = c.any;
           EXPECT_EQ(c.any, first_any[kind]);
         }
+      }
+    }
+  }
+}
+
+// The 8-wide BVH, counting the AO rays each path of a stream chunk takes.
+struct ChunkSpy {
+  const WideBvh* bvh;
+  mutable uint64_t streamed = 0, bundled = 0;
+  bool intersect(const Ray& r, Hit& h) const { return bvh->intersect(r, h); }
+  bool occluded(const Ray& r) const { return bvh->occluded(r); }
+  void intersect_packet(const RayPacket& p, Hit* h) const { bvh->intersect_packet(p, h); }
+  uint32_t occluded_bundle_from(const RayBundle& b, uint32_t origin) const {
+    bundled += uint64_t(std::popcount(b.active));
+    return bvh->occluded_bundle_from(b, origin);
+  }
+  void occluded_stream(const RayStream& s, StreamMask& m) const {
+    streamed += s.size;
+    bvh->occluded_stream(s, m);
+  }
+};
+
+// A stream chunk's AO rays go as a stream where its probe finds them nearly all blocked (inside a
+// closed box) and as bundles where a quarter or more escape (a floor under the open sky); either
+// way each pixel's colour is the one the 4x4 blocks give (as radiance() does, tested elsewhere).
+TEST(Render, StreamChunksTraceOpenViewsByBundlesAndClosedOnesAsStreams) {
+  const auto quad = [](std::vector<Triangle>& t, Vec3 o, Vec3 u, Vec3 v) {
+    t.push_back({o, o + u, o + u + v});
+    t.push_back({o, o + u + v, o + v});
+  };
+  std::vector<Triangle> floor, box;
+  quad(floor, {-100, 0, -100}, {200, 0, 0}, {0, 0, 200});
+  for (int a = 0; a < 3; ++a) {  // the six faces of the cube [-1, 1]^3
+    Vec3 o{-1, -1, -1}, u{0, 0, 0}, v{0, 0, 0};
+    u[(a + 1) % 3] = 2.0f;
+    v[(a + 2) % 3] = 2.0f;
+    quad(box, o, u, v);
+    o[a] = 1.0f;
+    quad(box, o, u, v);
+  }
+  struct Case {
+    const char* name;
+    Scene scene;
+    CameraSpec camera;
+    bool streamed;
+  };
+  Case cases[] = {{"floor", test::scene_of(floor), CameraSpec{{0, 5, 0}, {0, 0, 0}, {0, 0, -1}, 60.0f}, false},
+                  {"box", test::scene_of(box), CameraSpec{{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 60.0f}, true}};
+  for (Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    RenderSettings s;
+    s.width = s.height = kChunkEdge;
+    s.ao_samples = 16;
+    const WideBvh bvh(c.scene, BvhBuildOptions{});
+    const ChunkSpy spy{&bvh};
+    Framebuffer fb(s.width, s.height);
+    const PassContext ctx{&c.scene, Camera(c.camera, s.width, s.height), s, &fb};
+    const PixelChunk chunk{0, 0, kChunkEdge, kChunkEdge};
+    Vec3 streamed[kChunkPixels];
+    RayCounts counts;
+    AoIntegrator{}.chunk_radiance(spy, ctx, chunk, streamed, counts);
+    EXPECT_EQ(counts.ao, uint64_t(kChunkPixels) * 16u);
+    EXPECT_EQ(spy.streamed + spy.bundled, counts.ao);
+    EXPECT_EQ(spy.streamed > 0, c.streamed);
+    EXPECT_EQ(spy.bundled, c.streamed ? 16u * 16u : counts.ao);  // the probe: a pixel per 4x4 block
+    for (int by = 0; by < kChunkEdge; by += kPacketEdge) {
+      for (int bx = 0; bx < kChunkEdge; bx += kPacketEdge) {
+        const PixelBlock block = primary_block(ctx, bx, by, kChunkEdge, kChunkEdge);
+        Vec3 blocks[kPacketSize];
+        AoIntegrator{}.block_radiance(bvh, ctx, block, blocks, counts);
+        for (int k = 0; k < kPacketSize; ++k) EXPECT_EQ(streamed[chunk.index(block.x(k), block.y(k))], blocks[k]);
       }
     }
   }

@@ -46,35 +46,42 @@ inline Vec3 with_ambient(const RenderSettings& s, const SurfaceInteraction& si, 
   return direct + si.mat->kd * (s.ambient * unoccluded);
 }
 
+// How many of `si`'s AO rays (sample `sample` of pixel (x, y)) escape: by bundles of 16 with
+// packets, else one by one.
+template <class Accel>
+int open_ao_rays(const Accel& accel, const RenderSettings& s, int x, int y, const SurfaceInteraction& si,
+                 RayCounts& counts, uint32_t sample = 0) {
+  int open = 0;
+  bool bundled = false;
+  if constexpr (BundleAccelerator<Accel>) {
+    if (s.packets) {
+      // Up to 16 rays at a time; each gets the answer it gets alone, so the image is the same.
+      for (int first = 0; first < s.ao_samples; first += kPacketSize) {
+        RayBundle bundle;
+        bundle.org = si.origin;
+        bundle.tfar = s.ao_distance;
+        const int count = std::min(kPacketSize, s.ao_samples - first);
+        for (int k = 0; k < count; ++k) bundle.set_direction(k, ao_ray(s, x, y, si, sample, first + k).dir);
+        open += count - std::popcount(accel.occluded_bundle_from(bundle, si.tri));
+      }
+      bundled = true;
+    }
+  }
+  if (!bundled) {
+    for (int i = 0; i < s.ao_samples; ++i)
+      open += occluded_leaving(accel, ao_ray(s, x, y, si, sample, i), si.tri) ? 0 : 1;
+  }
+  counts.ao += uint64_t(s.ao_samples);
+  return open;
+}
+
 // `direct` (the hit's emission and lamp light) plus the ambient term, scaled by the fraction of
 // `si`'s AO rays that escape: the pixel's colour.
 template <class Accel>
 Vec3 finish_with_ambient(const Accel& accel, const PassContext& ctx, int x, int y, const SurfaceInteraction& si,
                          Vec3 direct, RayCounts& counts, uint32_t sample = 0) {
   const RenderSettings& s = ctx.settings;
-  int open = 0;
-  if (s.ao_samples > 0) {
-    bool bundled = false;
-    if constexpr (BundleAccelerator<Accel>) {
-      if (s.packets) {
-        // Up to 16 rays at a time; each gets the answer it gets alone, so the image is the same.
-        for (int first = 0; first < s.ao_samples; first += kPacketSize) {
-          RayBundle bundle;
-          bundle.org = si.origin;
-          bundle.tfar = s.ao_distance;
-          const int count = std::min(kPacketSize, s.ao_samples - first);
-          for (int k = 0; k < count; ++k) bundle.set_direction(k, ao_ray(s, x, y, si, sample, first + k).dir);
-          open += count - std::popcount(accel.occluded_bundle_from(bundle, si.tri));
-        }
-        bundled = true;
-      }
-    }
-    if (!bundled) {
-      for (int i = 0; i < s.ao_samples; ++i)
-        open += occluded_leaving(accel, ao_ray(s, x, y, si, sample, i), si.tri) ? 0 : 1;
-    }
-    counts.ao += uint64_t(s.ao_samples);
-  }
+  const int open = s.ao_samples > 0 ? open_ao_rays(accel, s, x, y, si, counts, sample) : 0;
   return with_ambient(s, si, direct, open);
 }
 
@@ -167,6 +174,25 @@ struct AoIntegrator {
       }
     }
     if (s.ao_samples > 0) {
+      // The probe: the corner pixel of each 4x4 block (where lit) traces its AO rays by bundles.
+      // Where a quarter or more of them escape, the chunk's other pixels do too: escaping rays
+      // cross the tree, where a stream's packets of rays from scattered origins cost more than a
+      // bundle from one point (the Bunny: 1731 instructions a ray as a stream, 1199 so probed,
+      // bundles 1192). Else the rest go as one stream, which the occluder cache makes cheap where
+      // nearly every ray is blocked (Sponza: probing costs 22 of 762 a ray). docs/bench/LOG.md.
+      std::array<uint32_t, kChunkPixels / 32> probed{};
+      int probe_rays = 0, probe_open = 0;
+      for (int cy = 0; cy < kChunkEdge; cy += kPacketEdge) {
+        for (int cx = 0; cx < kChunkEdge; cx += kPacketEdge) {
+          const int p = cy * kChunkEdge + cx;
+          if (!(lit[size_t(p) / 32] >> (p % 32) & 1u)) continue;
+          open[p] = open_ao_rays(accel, s, chunk.x(p), chunk.y(p), sis[p], counts);
+          probed[size_t(p) / 32] |= 1u << (p % 32);
+          probe_rays += s.ao_samples;
+          probe_open += open[p];
+        }
+      }
+      const bool stream_rest = 4 * probe_open < probe_rays;
       static thread_local RayStream stream;  // 160 KB: kept per thread, not on the stack
       stream.size = 0;
       const auto flush = [&] {
@@ -177,7 +203,11 @@ struct AoIntegrator {
         stream.size = 0;
       };
       for (int p = 0; p < kChunkPixels; ++p) {
-        if (!(lit[size_t(p) / 32] >> (p % 32) & 1u)) continue;
+        if (!(lit[size_t(p) / 32] >> (p % 32) & 1u) || (probed[size_t(p) / 32] >> (p % 32) & 1u)) continue;
+        if (!stream_rest) {
+          open[p] = open_ao_rays(accel, s, chunk.x(p), chunk.y(p), sis[p], counts);
+          continue;
+        }
         for (int i = 0; i < s.ao_samples; ++i) {
           if (stream.full()) flush();
           stream.push(ao_ray(s, chunk.x(p), chunk.y(p), sis[p], 0, i), uint16_t(p));

@@ -57,8 +57,9 @@ HWY_INLINE uint32_t OccludedByTrianglePacket(const TrianglePack& p, int k, const
 // The lanes of `active` of `st` (rays sharing their shear axes, each up to its tfar in st.t)
 // that are occluded in `bvh`: a walk down the tree with the lanes that enter each child, children
 // pushed in slot order (the last, the smallest subtree, searched first, as a single ray's any-hit
-// does), occluded lanes leaving every entry. `last_pack` is set to the last pack that occluded
-// a lane (for the occluder cache).
+// does), occluded lanes leaving every entry. `last_pack` is set to the last pack visited once a
+// lane of its entry is occluded, by it or earlier (for the occluder cache; keeping only packs that
+// occluded a lane themselves cost 0.6 % more instructions a ray in the Bunny, 0.2 % in Sponza).
 template <class Count>
 HWY_INLINE uint32_t OccludedPacketInTree(const WideBvh& bvh, const PacketState& st, uint32_t active, Count count,
                                          uint32_t& last_pack) {
