@@ -156,6 +156,7 @@ struct AoIntegrator {
     SurfaceInteraction sis[kChunkPixels];
     int open[kChunkPixels] = {};
     std::array<uint32_t, kChunkPixels / 32> lit{};
+    const auto is_lit = [&lit](int p) { return (lit[size_t(p) / 32] >> (p % 32) & 1u) != 0; };
     for (int by = chunk.y0; by < chunk.y1; by += kPacketEdge) {
       for (int bx = chunk.x0; bx < chunk.x1; bx += kPacketEdge) {
         const PixelBlock block = primary_block(ctx, bx, by, chunk.x1, chunk.y1);
@@ -181,17 +182,13 @@ struct AoIntegrator {
       // 1199 so probed, bundles 1192). Else the rest go as one stream, which the occluder cache
       // makes cheap where nearly every ray is blocked (Sponza: probing costs 22 of 762 a ray).
       // docs/bench/LOG.md, session 31.
-      std::array<uint32_t, kChunkPixels / 32> probed{};
+      const auto is_probe = [](int p) { return p % kPacketEdge == 0 && p / kChunkEdge % kPacketEdge == 0; };
       int probe_rays = 0, probe_open = 0;
-      for (int cy = 0; cy < kChunkEdge; cy += kPacketEdge) {
-        for (int cx = 0; cx < kChunkEdge; cx += kPacketEdge) {
-          const int p = cy * kChunkEdge + cx;
-          if (!(lit[size_t(p) / 32] >> (p % 32) & 1u)) continue;
-          open[p] = open_ao_rays(accel, s, chunk.x(p), chunk.y(p), sis[p], counts);
-          probed[size_t(p) / 32] |= 1u << (p % 32);
-          probe_rays += s.ao_samples;
-          probe_open += open[p];
-        }
+      for (int p = 0; p < kChunkPixels; ++p) {
+        if (!is_probe(p) || !is_lit(p)) continue;
+        open[p] = open_ao_rays(accel, s, chunk.x(p), chunk.y(p), sis[p], counts);
+        probe_rays += s.ao_samples;
+        probe_open += open[p];
       }
       const bool stream_rest = 4 * probe_open < probe_rays;
       static thread_local RayStream stream;  // 160 KB: kept per thread, not on the stack
@@ -204,7 +201,7 @@ struct AoIntegrator {
         stream.size = 0;
       };
       for (int p = 0; p < kChunkPixels; ++p) {
-        if (!(lit[size_t(p) / 32] >> (p % 32) & 1u) || (probed[size_t(p) / 32] >> (p % 32) & 1u)) continue;
+        if (!is_lit(p) || is_probe(p)) continue;
         if (!stream_rest) {
           open[p] = open_ao_rays(accel, s, chunk.x(p), chunk.y(p), sis[p], counts);
           continue;
@@ -218,7 +215,7 @@ struct AoIntegrator {
       if (stream.size > 0) flush();
     }
     for (int p = 0; p < kChunkPixels; ++p)
-      if (lit[size_t(p) / 32] >> (p % 32) & 1u) radiance[p] = with_ambient(s, sis[p], radiance[p], open[p]);
+      if (is_lit(p)) radiance[p] = with_ambient(s, sis[p], radiance[p], open[p]);
   }
 };
 
