@@ -489,12 +489,11 @@ test::CommandResult stall_one_rank(const std::string& command, const std::string
       const auto [code, seconds] = wait_for(launcher);
       return {code, read_file(log)};
     }
-    // Rank 0 writes the image and aborts the job; the stopped rank is killed where it stands
-    // (SIGKILL ends a stopped process): continued first, it could run long enough to report rank
-    // 0's silence as a second error, as a loaded CI machine once let it.
-    for (int i = 0; i < 900 && !(fs::exists(image) && pids_of_rank(0, dir).empty()); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
+    // Rank 0 writes the image (renamed into place whole) and aborts the job; the stopped rank is
+    // killed where it stands (SIGKILL ends a stopped process) as soon as the image appears. Left
+    // stopped until rank 0 had exited, it was continued by mpirun's abort (SIGCONT, SIGTERM) and
+    // on a loaded CI machine ran long enough to report rank 0's silence as a second error.
+    for (int i = 0; i < 4500 && !fs::exists(image); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     ::kill(victim, SIGKILL);
     ::kill(victim, SIGCONT);
   }
@@ -524,7 +523,12 @@ TEST_F(MpiRender, AStalledRankIsWorkedAroundAndNamed) {
               std::string::npos)
         << m.output;
     EXPECT_TRUE(same_bytes(read_file(image), expected));
-    EXPECT_EQ(own_lines(m.output), 1) << m.output;
+    // One error from the job. The stopped rank itself may add one: mpirun's abort continues it
+    // (SIGCONT, SIGTERM) before the test can kill it, and it reports rank 0's silence at once,
+    // its wait having run out while it was stopped; a rank that really hangs says nothing.
+    const std::string victims_own = "tracer-mpi: error: rank " + std::to_string(victim) + " of " +
+                                    std::to_string(ranks) + ": rank 0 stopped answering";
+    EXPECT_EQ(own_lines(m.output) - (m.output.find(victims_own) != std::string::npos ? 1 : 0), 1) << m.output;
   }
 }
 
