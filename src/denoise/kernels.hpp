@@ -1,8 +1,8 @@
 // The denoiser's inner loops over one tile and one neighbour offset, compiled once per SIMD
-// target (kernels.cpp) and chosen at run time: NL-means patch distances, the weighted sums of an
-// NL-means filter, and the sums of a weighted first-order regression. Everything runs offset by
-// offset over a tile's pixels, a row of them a few SIMD vectors: the loops are
-// flat, and a pixel's result depends on its neighbourhood only, not on the tiling or the thread.
+// target (filter_kernels.cpp, regression_kernels.cpp) and chosen at run time: NL-means patch distances, the weighted
+// sums of an NL-means filter, and the sums of a weighted first-order regression. Everything runs offset by offset over
+// a tile's pixels, a row of them a few SIMD vectors: the loops are flat, and a pixel's result depends on its
+// neighbourhood only, not on the tiling or the thread.
 #pragma once
 
 #include "base/simd_dispatch.hpp"

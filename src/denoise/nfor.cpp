@@ -154,11 +154,27 @@ Planes box3(const Context& cx, const Planes& in) {
 }
 
 // The film's halves as planes: colour, the variance of each half's mean, and the features, with
-// the distance scaled by its mean over the image so that every regressor is of order one.
+// the distance scaled by its mean over the image so that every regressor is of order one. The
+// colour is scaled too (by `colour_scale`, a power of two, so exactly) where its mean is far from
+// one: its squares (variances, patch distances) would overflow float above about 1e19 and sink
+// below the filters' epsilon in a dim image; NFOR is linear in the colour, so the result is
+// scaled back.
 struct Halves {
   std::array<Planes, 2> colour, variance, features;
   Planes feature_variance;  // of one half's mean, from the halves' difference, 3x3-averaged
+  float colour_scale = 1.0f;
 };
+
+// The power of two by which the colour is multiplied: 1 while the mean colour lies within
+// [2^-16, 2^16] (every ordinary render, whose bytes it keeps), else one that brings the mean to
+// [1, 2) -- but never one that lifts the brightest value's square past float's range.
+float colour_scale_of(double mean, double brightest) {
+  if (!(mean > 0.0) || !std::isfinite(mean) || (mean >= 0x1p-16 && mean <= 0x1p16 && brightest <= 0x1p60)) {
+    return 1.0f;
+  }
+  const int k = std::min(-std::ilogb(mean), 60 - std::ilogb(std::max(brightest, mean)));
+  return std::ldexp(1.0f, std::clamp(k, -120, 120));
+}
 
 Halves halves_of(const Context& cx, const FeatureFilm& film) {
   using F = FeatureFilm;
@@ -169,9 +185,9 @@ Halves halves_of(const Context& cx, const FeatureFilm& film) {
     hv.variance[size_t(s)] = Planes(w, h, 3);
     hv.features[size_t(s)] = Planes(w, h, kFeatures);
   }
-  // Per row, summed in row order afterwards: the same scale whatever the threads.
-  std::vector<double> distance_sum(size_t(h), 0.0);
-  std::vector<uint64_t> distance_count(size_t(h), 0);
+  // Per row, summed in row order afterwards: the same scales whatever the threads.
+  std::vector<double> distance_sum(size_t(h), 0.0), colour_sum(size_t(h), 0.0), brightest(size_t(h), 0.0);
+  std::vector<uint64_t> distance_count(size_t(h), 0), colour_count(size_t(h), 0);
   for_pixels(cx, w, h, [&](int x, int y) {
     const float n[2] = {film.get(x, y, 0, F::kCount), film.get(x, y, 1, F::kCount)};
     for (int s = 0; s < 2; ++s) {
@@ -180,24 +196,17 @@ Halves halves_of(const Context& cx, const FeatureFilm& film) {
       const float count = n[from];
       if (count == 0.0f) continue;
       for (int c = 0; c < 3; ++c) {
-        hv.colour[size_t(s)](c, x, y) = film.get(x, y, from, F::kRadiance + c) / count;
+        const float colour = film.get(x, y, from, F::kRadiance + c) / count;
+        hv.colour[size_t(s)](c, x, y) = colour;
+        if (std::isfinite(colour)) {
+          colour_sum[size_t(y)] += double(std::fabs(colour));
+          brightest[size_t(y)] = std::max(brightest[size_t(y)], double(std::fabs(colour)));
+          ++colour_count[size_t(y)];
+        }
         hv.features[size_t(s)](c, x, y) = film.get(x, y, from, F::kAlbedo + c) / count;
         hv.features[size_t(s)](3 + c, x, y) = film.get(x, y, from, F::kNormal + c) / count;
       }
       hv.features[size_t(s)](6, x, y) = film.get(x, y, from, F::kDepth) / count;
-    }
-    for (int s = 0; s < 2; ++s) {
-      for (int c = 0; c < 3; ++c) {
-        float v;
-        if (n[s] >= 2.0f) {
-          const float sum = film.get(x, y, s, F::kRadiance + c), sum2 = film.get(x, y, s, F::kRadiance2 + c);
-          v = std::max(0.0f, (sum2 - sum * sum / n[s]) / (n[s] * (n[s] - 1.0f)));
-        } else {
-          // One sample in a half: its variance as the halves' difference tells it.
-          v = square(hv.colour[0](c, x, y) - hv.colour[1](c, x, y)) * 0.5f;
-        }
-        hv.variance[size_t(s)](c, x, y) = v;
-      }
     }
     const float d = 0.5f * (hv.features[0](6, x, y) + hv.features[1](6, x, y));
     if (d > 0.0f && std::isfinite(d)) {
@@ -205,15 +214,40 @@ Halves halves_of(const Context& cx, const FeatureFilm& film) {
       ++distance_count[size_t(y)];
     }
   });
-  double sum = 0.0;
-  uint64_t count = 0;
+  double sum = 0.0, csum = 0.0, cmax = 0.0;
+  uint64_t count = 0, ccount = 0;
   for (int y = 0; y < h; ++y) {
     sum += distance_sum[size_t(y)];
     count += distance_count[size_t(y)];
+    csum += colour_sum[size_t(y)];
+    ccount += colour_count[size_t(y)];
+    cmax = std::max(cmax, brightest[size_t(y)]);
   }
   const float scale = count > 0 && sum > 0.0 ? float(double(count) / sum) : 1.0f;
+  const float cs = colour_scale_of(ccount > 0 ? csum / double(ccount) : 0.0, cmax);
+  hv.colour_scale = cs;
   Planes difference(w, h, kFeatures);
   for_pixels(cx, w, h, [&](int x, int y) {
+    const float n[2] = {film.get(x, y, 0, F::kCount), film.get(x, y, 1, F::kCount)};
+    for (int s = 0; s < 2; ++s) {
+      for (int c = 0; c < 3; ++c) hv.colour[size_t(s)](c, x, y) *= cs;
+    }
+    for (int s = 0; s < 2; ++s) {
+      for (int c = 0; c < 3; ++c) {
+        // In double: the sums' squares overflow float long before the film's sums do. A sum of
+        // squares that overflowed the film (a sample above 1.8e19) leaves the halves' difference.
+        const double sum2 = film.get(x, y, s, F::kRadiance2 + c);
+        double v;
+        if (n[s] >= 2.0f && std::isfinite(sum2)) {
+          const double total = film.get(x, y, s, F::kRadiance + c), m = n[s];
+          v = std::max(0.0, (sum2 - total * total / m) / (m * (m - 1.0))) * double(cs) * double(cs);
+        } else {
+          // One sample in a half: its variance as the halves' difference tells it.
+          v = double(square(hv.colour[0](c, x, y) - hv.colour[1](c, x, y))) * 0.5;
+        }
+        hv.variance[size_t(s)](c, x, y) = float(v);
+      }
+    }
     for (int s = 0; s < 2; ++s) hv.features[size_t(s)](6, x, y) *= scale;
     for (int c = 0; c < kFeatures; ++c) {
       difference(c, x, y) = square(hv.features[0](c, x, y) - hv.features[1](c, x, y)) * 0.5f;
@@ -246,6 +280,11 @@ Guide demodulated(const Context& cx, const Planes& colour, const Planes& varianc
 }
 
 }  // namespace
+
+uint64_t nfor_peak_bytes(int width, int height) {
+  return uint64_t(kPeakChannels) * Planes::floats_per_channel(width, height) * sizeof(float) +
+         uint64_t(width) * uint64_t(height) * sizeof(Vec3);
+}
 
 std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, CancelFlag cancel, const NforOptions& o) {
   const int w = film.width(), h = film.height();
@@ -321,8 +360,9 @@ std::vector<Vec3> nfor(const FeatureFilm& film, const Executor& executor, Cancel
                                                           features, o.patch, o.radius, kFinal, false)[0])
                                       : std::move(combined);
   std::vector<Vec3> out(size_t(w) * size_t(h));
+  const float unscale = 1.0f / hv.colour_scale;
   for_pixels(cx, w, h, [&](int x, int y) {
-    out[size_t(y) * size_t(w) + size_t(x)] = Vec3{result(0, x, y), result(1, x, y), result(2, x, y)};
+    out[size_t(y) * size_t(w) + size_t(x)] = Vec3{result(0, x, y), result(1, x, y), result(2, x, y)} * unscale;
   });
   return out;
 }

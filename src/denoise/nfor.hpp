@@ -14,6 +14,7 @@
 // tiles, threads, scheduler or ranks that rendered or denoised it.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "base/errors.hpp"
@@ -34,6 +35,12 @@ struct NforOptions {
   bool second_pass = true;                    // 5.4
   SimdTarget simd = SimdTarget::Auto;         // the widest target its kernels may use (--simd-target)
 };
+
+// The bytes nfor() holds at its peak for a width x height film (the film itself not counted): the
+// planes live at once in 5.4 (kPeakChannels, counted in nfor.cpp's order of steps), each padded
+// to whole tiles and a border, and the result.
+inline constexpr int kPeakChannels = 127;
+uint64_t nfor_peak_bytes(int width, int height);
 
 // The denoised radiance of every pixel of `film`, row-major. Throws Cancelled once `cancel` is
 // set (checked between tiles).

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "base/huge_pages.hpp"
 
@@ -36,6 +37,13 @@ class Planes {
   Planes& operator=(Planes&&) noexcept = default;
   Planes(const Planes&) = delete;  // hundreds of MB: moved, never copied
   Planes& operator=(const Planes&) = delete;
+
+  // The floats one channel of a width x height image holds, its border and padding included: a
+  // thin image pads every row to a whole tile and a border (a 1-pixel column holds 170 floats a row).
+  static uint64_t floats_per_channel(int width, int height) {
+    return uint64_t(round_up(width, kTileWidth) + 2 * kBorder + kPatchColumns) *
+           uint64_t(round_up(height, kTileHeight) + 2 * kBorder);
+  }
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -4,6 +4,7 @@
 
 #include "base/errors.hpp"
 #include "base/memory_limit.hpp"
+#include "denoise/nfor.hpp"
 #include "frontend/render_options.hpp"
 
 namespace tracer::frontend {
@@ -19,7 +20,8 @@ uint64_t film_bytes(const RenderArgs& args) {
                           uint64_t(aovs.noisy) + uint64_t(aovs.variance);
   const uint64_t per_pixel = kFilmBytesPerPixel + (adaptive(settings) ? kHalvesBytesPerPixel : 0) +
                              layers * kLayerBytesPerPixel + (args.denoise ? kDenoiseBytesPerPixel : 0);
-  return uint64_t(settings.width) * uint64_t(settings.height) * per_pixel;
+  return uint64_t(settings.width) * uint64_t(settings.height) * per_pixel +
+         (args.denoise ? denoise::nfor_peak_bytes(settings.width, settings.height) : 0);
 }
 
 void check_film_fits(const RenderArgs& args, uint64_t limit) {

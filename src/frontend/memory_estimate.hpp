@@ -19,10 +19,11 @@ namespace tracer::frontend {
 inline constexpr uint64_t kFilmBytesPerPixel = 26;
 inline constexpr uint64_t kHalvesBytesPerPixel = 12;
 inline constexpr uint64_t kLayerBytesPerPixel = 24;
-// --denoise: the feature film (film/feature_film.hpp), the denoised copy and the denoiser's
-// planes at their peak, measured as the peak resident set of `tracer render --spp 1 --denoise`
-// at 2048 x 2048 less that without (644 bytes), rounded up.
-inline constexpr uint64_t kDenoiseBytesPerPixel = 660;
+// --denoise: the feature film (film/feature_film.hpp, 112 bytes) and the denoised copy, per
+// pixel; the denoiser's planes are denoise::nfor_peak_bytes (padded: a thin image's are many
+// times its pixels). Checked against the peak resident set of `tracer render --spp 1 --denoise`
+// less that without, at 2048 x 2048 and at 1 x 16384 (docs/RELIABILITY.md, "Memory").
+inline constexpr uint64_t kDenoiseBytesPerPixel = 136;
 
 // The limit: --max-memory-mib, or the available memory less a margin (base/memory_limit.hpp).
 uint64_t memory_limit(const SceneArgs& args);

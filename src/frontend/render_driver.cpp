@@ -63,21 +63,28 @@ DriveResult drive_render(const Scene& scene, const CameraSpec& camera, const Ren
           for (int x = 0; x < fb->width(); ++x) counts->set(x, y, Vec3{float(fb->samples(x, y))});
         }
       }
+      // --denoise: the denoised image, unless the write is a stop's partial one or a stop comes
+      // while denoising; then the noisy image, and the stop says so (every sample was taken).
       const Framebuffer* image = &*fb;
+      result.not_denoised = features.has_value();
       if (features && final_image) {
         const auto start = Clock::now();
-        const std::vector<Vec3> d =
-            denoise::nfor(*features, *options.denoiser, options.cancel, {.simd = seq.denoise_simd});
-        result.denoise_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-        for (int y = 0; y < fb->height(); ++y) {
-          for (int x = 0; x < fb->width(); ++x) denoised->set(x, y, d[size_t(y) * size_t(fb->width()) + size_t(x)]);
-        }
-        if (variance) {
+        try {
+          const std::vector<Vec3> d =
+              denoise::nfor(*features, *options.denoiser, options.cancel, {.simd = seq.denoise_simd});
           for (int y = 0; y < fb->height(); ++y) {
-            for (int x = 0; x < fb->width(); ++x) variance->set(x, y, features->variance_of_mean(x, y));
+            for (int x = 0; x < fb->width(); ++x) denoised->set(x, y, d[size_t(y) * size_t(fb->width()) + size_t(x)]);
           }
+          if (variance) {
+            for (int y = 0; y < fb->height(); ++y) {
+              for (int x = 0; x < fb->width(); ++x) variance->set(x, y, features->variance_of_mean(x, y));
+            }
+          }
+          image = &*denoised;
+          result.not_denoised = false;
+        } catch (const Cancelled&) {  // written noisy, below
         }
-        image = &*denoised;
+        result.denoise_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
       }
       const size_t clamped = write_render(output, *image, settings.exposure, seq.exr, layers);
       if (clamped > 0 && !warned_clamped) {

@@ -50,7 +50,8 @@ struct DriveResult {
   std::string output;
   uint32_t samples = 0;
   bool wrote_partial = false;
-  double denoise_ms = 0.0;  // --denoise: time spent denoising, every write included
+  double denoise_ms = 0.0;    // --denoise: time spent denoising, every write included
+  bool not_denoised = false;  // --denoise: the last image written is the noisy one (a stop came first)
 };
 
 // How this process takes part in a render.
