@@ -146,7 +146,8 @@ TEST_F(Cli, BadInputsGiveOneLineErrorsAndExitCodes) {
       {"render --integrator path --env-map x.exr --env-rotation nan", 2, "--env-rotation: must be at least -1e+06"},
       {"render --integrator path --env-map x.exr --env-rotation 1e300", 2,
        "--env-rotation: must be at least -1e+06 and at most 1e+06, got 1e+300"},
-      {"render --integrator path --env 1,-1,1", 2, "--env: each component must be in [0, 1e30], got '1,-1,1'"},
+      {"render --integrator path --env 1,-1,1", 2,
+       "--env: each component must be in [0, 1e6] (the radiance limit of every format), got '1,-1,1'"},
       {"render --integrator path --env 1,1", 2, "--env: expected three numbers"},
       {"render --integrator path --light-sampling nee", 2, "--light-sampling: unknown light sampling 'nee'"},
       {"render --integrator path --checkpoint 0", 2, "--checkpoint: must be above 0"},
@@ -263,6 +264,16 @@ TEST_F(Cli, OutputErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
+// A --stats-json that cannot be written fails the run after the image was written, and says both.
+TEST_F(Cli, AStatsJsonThatCannotBeWrittenSaysTheImageWas) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const auto r = test::run_tracer("render -q --width 8 --height 8 -o " + dir_ + "/kept.png --stats-json /dev/full");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.output.rfind("tracer: error: --stats-json: ", 0), 0u) << r.output;
+  EXPECT_NE(r.output.find("(the image was written)"), std::string::npos) << r.output;
+  EXPECT_EQ(read_image(dir_ + "/kept.png").width, 8);
+}
+
 TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
   // A scene path with a quote and a backslash: the JSON must escape both.
   const std::string scene = dir_ + "/a\"b\\c.obj";
@@ -277,6 +288,13 @@ TEST_F(Cli, StatsJsonNeverOverwritesInputsAndParsesBack) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("is also the -o image"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ + "/x.png"));
+  // Against the names the frames expand to: frame 1 of -o fr.png is fr-0001.png.
+  r = test::run_tracer("render " + quoted_scene + " -q --width 8 --height 8 --frames 2 -o " + dir_ +
+                       "/fr.png --stats-json " + dir_ + "/fr-0001.png");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is also frame 1's image"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ + "/fr-0000.png"));
+  EXPECT_FALSE(fs::exists(dir_ + "/fr-0001.png"));
   r = test::run_tracer("render " + quoted_scene + " -q --integrator ao --width 8 --height 6 --ao 2 -o " + dir_ +
                        "/x.png --stats-json " + dir_ + "/s.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -331,6 +349,39 @@ TEST_F(Cli, SceneWithoutEmittersIsLitByAWhiteSkyWithANote) {
                                     "--light 0,0,5 --env 0,0,0 -o " + dir_ + "/e.png");
   ASSERT_EQ(lit.exit_code, 0) << lit.output;
   EXPECT_EQ(lit.output, "");
+}
+
+// --no-scene-lights drops the emitters' emission too, not only their next-event list: the
+// built-in box under a black sky with no --light is black, every pixel, whatever the integrator
+// (a bounce that hit the lamp used to find it lit: 64 spp gave a mean of 36.8 of 255).
+TEST_F(Cli, NoSceneLightsLeavesNothingThatEmits) {
+  for (const char* integrator : {"path", "whitted"}) {
+    const std::string out = dir_ + "/dark-" + integrator + ".png";
+    // (whitted's ambient term, on by default, is a light of its own: turned off here)
+    const auto r =
+        test::run_tracer(std::string("render --integrator ") + integrator +
+                         " --no-scene-lights --env 0,0,0 --ambient 0 --spp 16 --width 24 --height 24 -q -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const Image8 image = read_image(out);
+    EXPECT_TRUE(std::all_of(image.rgb.begin(), image.rgb.end(), [](uint8_t v) { return v == 0; })) << integrator;
+  }
+  // With the scene's lights kept, the same render is lit (the test sees a difference).
+  const auto lit = test::run_tracer("render --integrator path --env 0,0,0 --spp 16 --width 24 --height 24 -q -o " +
+                                    dir_ + "/lit.png");
+  ASSERT_EQ(lit.exit_code, 0) << lit.output;
+  const Image8 image = read_image(dir_ + "/lit.png");
+  EXPECT_GT(std::count_if(image.rgb.begin(), image.rgb.end(), [](uint8_t v) { return v > 0; }), 100);
+}
+
+// A flag that takes a value each time it is given stops at that value: the scene after it is
+// the positional argument (CLI11 took it as a second --light and said it was not x,y,z).
+TEST_F(Cli, ARepeatableFlagTakesOneValueEachTime) {
+  const auto r = test::run_tracer("render --light 0,0,2 --light 0,1,2 " + dir_ +
+                                  "/ok.obj --eye 0,0,3 --look 0,0,0 --integrator ao --width 8 --height 8 -q -o " +
+                                  dir_ + "/two.png --stats-json " + dir_ + "/two.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(test::read_bytes(dir_ + "/two.json").find("2 point lights"), std::string::npos)
+      << test::read_bytes(dir_ + "/two.json");
 }
 
 TEST_F(Cli, ASceneWithoutLightsTakesItsViewFromAViewsFileBesideIt) {

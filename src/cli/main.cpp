@@ -45,6 +45,10 @@ int cmd_render(const RenderArgs& args) {
               << *args.threads << " run, sharing them\n";
   }
   if (!setup.lighting_note.empty() && !args.quiet) std::cerr << "tracer: note: " << setup.lighting_note << "\n";
+  if (args.focus_distance && setup.camera.lens_radius == 0.0f) {
+    std::cerr << "tracer: warning: --focus-distance: the camera is a pinhole (no --aperture), everything is in "
+                 "focus: it changes nothing\n";
+  }
   const Scene& scene = setup.scene;
   const RenderSettings& settings = setup.settings;
   const Accelerator& accel = setup.accel;
@@ -69,13 +73,14 @@ int cmd_render(const RenderArgs& args) {
   if (r.stopped) {
     progress.stop();
     std::cerr << "tracer: " << stop_signal_name();
+    const char* noisy = r.not_denoised ? " (not denoised)" : "";
     if (r.stopped_after_write) {
-      std::cerr << " after the render finished; image written to " << r.output << "\n";
+      std::cerr << " after the render finished; image written to " << r.output << noisy << "\n";
     } else if (r.samples > 0) {
       std::cerr << " after " << r.samples << " of " << settings.spp << " samples per pixel; image written to "
-                << r.output << "\n";
+                << r.output << noisy << "\n";
     } else if (r.wrote_partial) {
-      std::cerr << "; partial image written to " << r.output << "\n";
+      std::cerr << "; partial image written to " << r.output << noisy << "\n";
     } else {
       std::cerr << (args.save_partial ? " before any tile finished" : "") << "; no image written\n";
     }
@@ -92,7 +97,14 @@ int cmd_render(const RenderArgs& args) {
   stats["checkpoints_written"] = checkpoints;
   if (args.denoise) stats["denoise_ms"] = r.denoise_ms;
   if (args.stats) print_stats(stats, accel);
-  write_stats_json(args.stats_json, stats);
+  try {
+    write_stats_json(args.stats_json, stats);
+  } catch (const InputError& e) {
+    // The images are written by now: say which output failed and that they are not lost.
+    const std::string images =
+        args.frames > 1 ? "the " + std::to_string(args.frames) + " frames were" : "the image was";
+    throw InputError("--stats-json: " + std::string(e.what()) + " (" + images + " written)");
+  }
   return 0;
 }
 
@@ -148,11 +160,20 @@ int cmd_compare(const std::string& a, const std::string& b, std::optional<float>
 }  // namespace
 }  // namespace tracer::cli
 
+namespace {
+// The stop handlers, installed as the program is loaded: before the shared libraries' constructors
+// (TBB's, OpenEXR's, Embree's; tens of milliseconds, docs/RELIABILITY.md), during which a
+// background job's SIGINT, ignored since the shell started it, would be discarded by the kernel
+// and the viewer never stop.
+void install_at_load(int, char**, char**) { tracer::frontend::install_stop_handlers(); }
+[[gnu::section(".preinit_array"), gnu::used]] void (*const preinit_stop_handlers)(int, char**,
+                                                                                  char**) = install_at_load;
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace tracer;
   using namespace tracer::cli;
   using namespace tracer::frontend;
-  install_stop_handlers();  // first: see signals.hpp
   CLI::App app{"tracer: a fast parallel CPU ray tracer for OBJ, glTF 2.0 and PLY scenes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "tracer 0.1.0");
@@ -212,7 +233,7 @@ int main(int argc, char** argv) {
     // A value refused by its check names the flag and what it takes; CLI11's own errors (an
     // unknown flag, a missing value) point to the help.
     const bool value = dynamic_cast<const CLI::ValidationError*>(&e) != nullptr;
-    std::cerr << "tracer: error: " << e.what() << (value ? "\n" : " (see tracer --help)\n");
+    std::cerr << "tracer: error: " << parse_error_text(e.what()) << (value ? "\n" : " (see tracer --help)\n");
     return 2;
   }
   try {

@@ -27,7 +27,15 @@ void check_outputs(const RenderArgs& a) {
   if (!a.scene.scene.empty() && a.scene.scene != "-" && same_file(a.stats_json, a.scene.scene)) {
     throw UsageError("--stats-json: '" + a.stats_json + "' is the input scene");
   }
-  if (same_file(a.stats_json, a.output)) throw UsageError("--stats-json: '" + a.stats_json + "' is also the -o image");
+  // Against every name the frames expand to, not the literal -o: frame 1 of `-o fr.png` is fr-0001.png.
+  for (int frame = 0; frame < a.frames; ++frame) {
+    const std::string image = frame_output(a.output, frame, a.frames);
+    if (same_file(a.stats_json, image)) {
+      throw UsageError("--stats-json: '" + a.stats_json + "' is also " +
+                       (a.frames > 1 ? "frame " + std::to_string(frame) + "'s image (-o " + a.output + ")"
+                                     : std::string("the -o image")));
+    }
+  }
   check_writable(a.stats_json);
 }
 

@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <cinttypes>
 #include <cstdio>
 #include <iostream>
 
@@ -53,6 +54,8 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
   const double mrays = render_ms > 0 ? double(rays.total()) / (render_ms * 1e3) : 0.0;
   nlohmann::json j = {{"scene", scene.source},
                       {"triangles", scene.size()},
+                      {"instances", scene.instances.size()},
+                      {"placed_triangles", scene.instanced_size()},
                       {"width", settings.width},
                       {"height", settings.height},
                       {"ao_samples", settings.ao_samples},
@@ -104,7 +107,12 @@ nlohmann::json render_stats(const Scene& scene, const RenderSettings& settings, 
 
 void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   const auto str = [&](const char* k) { return j[k].get<std::string>(); };
-  std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
+  if (j["instances"].get<size_t>() > 0) {
+    std::printf("scene        %s (%" PRIu64 " triangles: %zu unique, placed by %zu instances)\n", str("scene").c_str(),
+                j["placed_triangles"].get<uint64_t>(), j["triangles"].get<size_t>(), j["instances"].get<size_t>());
+  } else {
+    std::printf("scene        %s (%zu triangles)\n", str("scene").c_str(), j["triangles"].get<size_t>());
+  }
   const std::string integrator = str("integrator");
   const std::string depth = std::to_string(j["max_depth"].get<int>());
   std::string workload = integrator == "ao"        ? std::to_string(j["ao_samples"].get<int>()) + " AO rays per hit"
@@ -121,8 +129,12 @@ void print_stats(const nlohmann::json& j, const Accelerator& accel) {
   std::printf("image        %dx%d, %s -> %s\n", j["width"].get<int>(), j["height"].get<int>(), workload.c_str(),
               str("output").c_str());
   std::printf("lighting     %s\n", str("lighting").c_str());
-  std::printf("accelerator  %s, %.1f bytes/triangle%s\n", str("accel").c_str(),
-              double(j["accel_bytes"].get<size_t>()) / double(j["triangles"].get<size_t>()),
+  // An instanced scene's tree holds its unique triangles and its instances: bytes per placed
+  // triangle, the figure beside a flat scene's (one instance of a triangle costs next to nothing).
+  const size_t instances = j["instances"].get<size_t>();
+  const double placed = double(j["placed_triangles"].get<uint64_t>());
+  std::printf("accelerator  %s, %.*f bytes/%s%s\n", str("accel").c_str(), instances ? 3 : 1,
+              double(j["accel_bytes"].get<size_t>()) / placed, instances ? "placed triangle" : "triangle",
               !j["packets"].get<bool>() ? ""
               : accel.kind == AccelKind::Bvh8
                   ? (j["streams"].get<bool>() ? ", primary rays in 4x4 packets, AO rays in sorted streams"

@@ -22,9 +22,13 @@ namespace tracer::frontend {
 
 namespace {
 
-// --no-scene-lights and --light, on top of the scene's (or the view's) lights.
+// --no-scene-lights and --light, on top of the scene's (or the view's) lights. Dropping the
+// scene's lights drops their emission too: a bounce that hits a lamp finds it black, as next-event
+// estimation (which samples the emitters) does.
 void add_lights(Scene& scene, const SceneArgs& a) {
   if (a.no_scene_lights) {
+    for (Material& m : scene.materials) m.ke = Vec3{0.0f};
+    for (Mesh& m : scene.meshes) m.emissive = false;
     scene.lights.clear();
     scene.emitters = Emitters{};
   }
@@ -54,7 +58,7 @@ void add_environment(Scene& scene, const SceneArgs& a, CancelFlag cancel, const 
     say(std::to_string(map.zeroed_values()) + " texel values negative or not finite, read as 0");
   }
   if (map.clamped_values() > 0) {
-    say(std::to_string(map.clamped_values()) + " texel values above 1e30, read as 1e30");
+    say(std::to_string(map.clamped_values()) + " texel values above the radiance limit 1e6, read as 1e6");
   }
   if (map.black()) say("the environment map is black: it lights nothing");
 }

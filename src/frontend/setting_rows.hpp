@@ -149,8 +149,9 @@ inline Codec<Vec3> vector(VecKind kind) {
         if (length(v) == 0.0f) throw UsageError(name + ": must not be the zero vector");
         break;
       case VecKind::Radiance:
-        if (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f || max_component(v) > 1e30f)
-          throw UsageError(name + ": each component must be in [0, 1e30], got '" + text + "'");
+        if (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f || max_component(v) > kMaxEmission)
+          throw UsageError(name + ": each component must be in [0, 1e6] (the radiance limit of every format), got '" +
+                           text + "'");
         break;
     }
   };

@@ -88,6 +88,9 @@ const Setting& setting(std::string_view flag);
 
 // Registers every row of `groups` as a flag of `app` writing into `args`.
 void add_settings(CLI::App& app, RenderArgs& args, std::initializer_list<SettingGroup> groups);
+// A command-line parse error's text as tracer prints it: CLI11's own words where they name the
+// flag plainly, else ours ("--spp: given 2 times; it takes one value", not "At Most 1 required").
+std::string parse_error_text(const std::string& cli11_message);
 // Checks every row's range, then the rules that tie flags together; throws UsageError naming the
 // flag. Changes nothing.
 void check_settings(const RenderArgs& args);

@@ -50,6 +50,10 @@ void check_combinations(const RenderArgs& a) {
   if (a.count && accel.kind != AccelKind::Bvh8) {
     throw UsageError("--count: only the 8-wide BVH counts its traversal (--accel bvh8, the default)");
   }
+  if (a.min_spp && a.spp && *a.min_spp > *a.spp) {
+    throw UsageError("--min-spp " + std::to_string(*a.min_spp) + ": above --spp " + std::to_string(*a.spp) +
+                     " (adaptive sampling's minimum cannot exceed the samples a pixel gets)");
+  }
   if (a.bvh.strategy == Strategy::Atomic) {
     throw UsageError("--build-sched: atomic hands out tiles; a build forks with seq, async, queue or tbb");
   }
@@ -81,6 +85,9 @@ void add_settings(CLI::App& app, RenderArgs& args, std::initializer_list<Setting
             for (const std::string& t : v) parse(t);
           },
           s.help);
+      // One value each time it is given: `--light 0,1,0 scene.obj` leaves the scene to the
+      // positional argument (CLI11 would take every following word).
+      option->expected(1)->allow_extra_args(false)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     } else {
       option = app.add_option_function<std::string>(s.names, parse, s.help);
       if (const std::optional<std::string> d = s.text(defaults)) option->default_str(*d);
@@ -88,6 +95,14 @@ void add_settings(CLI::App& app, RenderArgs& args, std::initializer_list<Setting
     if (!s.excludes.empty()) option->excludes(s.excludes);
     if (!s.value_name.empty()) option->type_name(s.value_name);
   }
+}
+
+std::string parse_error_text(const std::string& message) {
+  static constexpr std::string_view kAtMost = ": At Most 1 required but received ";
+  if (const size_t at = message.find(kAtMost); at != std::string::npos) {
+    return message.substr(0, at) + ": given " + message.substr(at + kAtMost.size()) + " times; it takes one value";
+  }
+  return message;
 }
 
 void check_settings(const RenderArgs& a) {

@@ -8,9 +8,10 @@
 
 namespace tracer::frontend {
 
-// The flag handlers. main() installs them first of all, so that a signal is never lost while
-// the process starts: a shell without job control starts a background job with SIGINT ignored,
-// and one that came before this call went with that. Each command then keeps them (it polls the
+// The flag handlers. tracer installs them as it is loaded (cli/main.cpp's .preinit_array entry,
+// before any library constructor), so that a signal is lost only in the few milliseconds of the
+// dynamic loader: a shell without job control starts a background job with SIGINT ignored, and
+// one that came before this call went with that. Each command then keeps them (it polls the
 // flag) or, where nothing polls it, asks for the immediate ones.
 void install_stop_handlers();
 // For a process that cannot stop cleanly on its own (a rank of an MPI job, whose peers the

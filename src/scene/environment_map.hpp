@@ -11,12 +11,12 @@
 #include "base/errors.hpp"
 #include "math/distribution.hpp"
 #include "math/vec.hpp"
+#include "scene/value_limits.hpp"
 
 namespace tracer {
 
-// The largest radiance a texel keeps (as --env's components): beyond it, products along a path
-// would overflow a float.
-inline constexpr float kMaxEnvironmentRadiance = 1e30f;
+// The largest radiance a texel keeps: the one limit of every radiance (scene/value_limits.hpp).
+inline constexpr float kMaxEnvironmentRadiance = kMaxEmission;
 
 class EnvironmentMap {
  public:

@@ -5,8 +5,10 @@
 
 namespace tracer {
 
-inline constexpr float kMaxReflectance = 1.0f;      // Ka Kd Ks Tf, glTF factors: fractions of light
-inline constexpr float kMaxEmission = 1e6f;         // emitted radiance (MTL Ke, glTF emissive x strength)
+inline constexpr float kMaxReflectance = 1.0f;  // Ka Kd Ks Tf, glTF factors: fractions of light
+// Radiance, however it enters: emission (MTL Ke, glTF emissive x strength), --env and each
+// environment-map texel (which --env then scales).
+inline constexpr float kMaxEmission = 1e6f;
 inline constexpr float kMaxShininess = 1e6f;        // Ns
 inline constexpr float kMaxIor = 100.0f;            // Ni, glTF ior (0 is accepted: exporters write it for "unset")
 inline constexpr double kMaxLightIntensity = 1e30;  // a point light's intensity (--light-intensity, glTF lights)
