@@ -17,6 +17,7 @@
 #include "frontend/render_args.hpp"
 #include "frontend/render_driver.hpp"
 #include "frontend/render_options.hpp"
+#include "frontend/settings_table.hpp"
 #include "frontend/signals.hpp"
 #include "mpi/mpi_session.hpp"
 #include "mpi/phase_watch.hpp"
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return session->root() ? app.exit(e) : 0;
     const bool value = dynamic_cast<const CLI::ValidationError*>(&e) != nullptr;  // as tracer's main
-    parse_error = std::string(e.what()) + (value ? "" : " (see tracer-mpi --help)");
+    parse_error = frontend::parse_error_text(e.what()) + (value ? "" : " (see tracer-mpi --help)");
   }
   try {
     return mpi::run(args, *session, parse_error, rank_timeout, watch);

@@ -16,21 +16,43 @@ PhaseWatch::~PhaseWatch() {
   thread_.join();
 }
 
+namespace {
+std::chrono::steady_clock::time_point after(double seconds) {
+  return std::chrono::steady_clock::now() +
+         std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+}  // namespace
+
 void PhaseWatch::arm(const std::string& message, double seconds) {
   {
     const std::lock_guard lock(mutex_);
     message_ = message;
     armed_ = true;
-    deadline_ = std::chrono::steady_clock::now() +
-                std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+    seconds_ = seconds;
+    deadline_ = after(seconds);
   }
   changed_.notify_all();
 }
 
 void PhaseWatch::progress(double seconds) {
   const std::lock_guard lock(mutex_);
-  deadline_ = std::chrono::steady_clock::now() +
-              std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+  seconds_ = seconds;
+  deadline_ = after(seconds);
+}
+
+void PhaseWatch::hold() {
+  const std::lock_guard lock(mutex_);
+  ++holds_;
+}
+
+void PhaseWatch::release(double seconds) {
+  {
+    const std::lock_guard lock(mutex_);
+    if (--holds_ > 0) return;
+    seconds_ = seconds;
+    deadline_ = after(seconds);
+  }
+  changed_.notify_all();
 }
 
 void PhaseWatch::disarm() {
@@ -41,15 +63,16 @@ void PhaseWatch::disarm() {
 void PhaseWatch::run() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    if (!armed_) {
+    if (!armed_ || holds_ > 0) {
       changed_.wait(lock);
       continue;
     }
     const auto now = std::chrono::steady_clock::now();
     if (now >= deadline_ + std::chrono::milliseconds(500)) {
-      // Woken far past the deadline: this process was itself stopped (SIGSTOP, a suspended VM),
-      // and blames no other rank for it; the deadline starts again.
-      deadline_ = now + std::chrono::seconds(2);
+      // Woken far past the deadline: this process was itself stopped or descheduled (SIGSTOP, a
+      // suspended VM, an oversubscribed machine), and blames no other rank for it; the whole
+      // bound starts again, since the others may have moved on (a round ended) while it was away.
+      deadline_ = after(seconds_);
       continue;
     }
     if (now >= deadline_) {

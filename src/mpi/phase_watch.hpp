@@ -23,6 +23,11 @@ class PhaseWatch {
   void arm(const std::string& message, double seconds);
   // The phase moved on: its deadline starts again, `seconds` from now.
   void progress(double seconds);
+  // While held (by any thread: holds count), the deadline does not run: this rank is busy with
+  // its own work (rendering a tile), not waiting for another. The last release() starts it
+  // again, `seconds` from then.
+  void hold();
+  void release(double seconds);
   void disarm();
 
  private:
@@ -30,6 +35,8 @@ class PhaseWatch {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::chrono::steady_clock::time_point deadline_;
+  double seconds_ = 0.0;  // the bound last set, for a deadline started again
+  int holds_ = 0;
   std::string message_;
   bool armed_ = false, stopping_ = false;
   std::thread thread_;

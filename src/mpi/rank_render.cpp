@@ -162,11 +162,12 @@ void RankRender::work_round(const PassContext& ctx, const std::vector<SampleRang
         if (args_.denoise) features = std::make_unique<FeatureFilm>(t);
         if (masks) active.set_window_blocks(ctx.settings.width, ctx.settings.height, t, worker.mask());
         const auto t0 = Clock::now();
+        watch_phase_.hold();  // the time spent rendering is not time waiting for rank 0
         count(render_one(setup_.accel, c, round, *result, features.get(), t), t, samples);
         const double took = ms_since(t0) * 1e-3;
         for (double seen = slowest_tile_s_.load(); took > seen && !slowest_tile_s_.compare_exchange_weak(seen, took);) {
         }
-        watch_phase_.progress(answer_bound());
+        watch_phase_.release(answer_bound());
         finished = *next;
       }
       std::lock_guard lock(idle_mutex_);
