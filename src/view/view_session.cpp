@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "base/errors.hpp"
-#include "denoise/nfor.hpp"
+#include "base/stopwatch.hpp"
 #include "frontend/render_options.hpp"
 #include "frontend/scene_setup.hpp"
 #include "frontend/settings_table.hpp"
@@ -18,8 +18,6 @@ namespace tracer::view {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 // A preview is sized to render within this; the full image follows it.
 constexpr double kPreviewBudgetMs = 30.0;
 // Changes closer together than this are a camera in motion: after its preview the renderer waits
@@ -28,11 +26,7 @@ constexpr double kPreviewBudgetMs = 30.0;
 // move would interrupt.
 constexpr auto kMotionInterval = std::chrono::milliseconds(150);
 constexpr auto kMotionPause = std::chrono::milliseconds(100);
-// Frames of a pass in progress (tiles refined so far) come at most this often.
-constexpr auto kProgressInterval = std::chrono::milliseconds(200);
-constexpr int kJpegQuality = 88;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double seconds_since(Clock::time_point t) { return ms_since(t) * 1e-3; }
 
 // Whether a state's image is denoised: the toggle on (for path tracing) and the image within
 // kMaxDenoisedPixels, whose denoiser planes take 2.8 GB (docs/VIEW.md).
@@ -375,79 +369,6 @@ bool ViewSession::render_job(const Job& job) {
     publish_display(true);
   }
   return true;
-}
-
-bool ViewSession::denoise_display(const Job& job, bool last_pass) {
-  // At most a third of the time goes to denoising; the last pass's image always is.
-  if (!last_pass && display_denoised_ && seconds_since(denoised_at_) < 2e-3 * denoise_ms_) return true;
-  const auto t0 = Clock::now();
-  std::vector<Vec3> image;
-  try {
-    image = denoise::nfor(*features_, denoiser_, &interrupt_,
-                          {.simd = launched_.simd_target});  // a change stops it within a tile
-  } catch (const Cancelled&) {
-    return false;
-  }
-  denoise_ms_ = seconds_since(t0) * 1e3;
-  denoised_at_ = Clock::now();
-  {
-    const std::lock_guard lock(display_mu_);
-    if (display_generation_ != job.generation || !display_) return true;
-    const int w = display_->width();
-    for (int y = 0; y < display_->height(); ++y) {
-      for (int x = 0; x < w; ++x) display_->set(x, y, image[size_t(y) * size_t(w) + size_t(x)]);
-    }
-    display_image_ = tonemap(*display_, exposure_);
-    display_spp_ = film_done_;
-    display_denoised_ = true;
-    display_awaits_denoise_ = false;
-  }
-  publish_display(true);
-  return true;
-}
-
-void ViewSession::publish_display(bool force) {
-  std::unique_lock publish(publish_mu_, std::defer_lock);
-  if (force) {
-    publish.lock();
-  } else if (Clock::now() - last_publish_ < kProgressInterval || !publish.try_lock()) {
-    return;
-  }
-  auto meta = std::make_shared<Frame>();
-  Image8 image;
-  {
-    const std::lock_guard lock(display_mu_);
-    if (!display_) return;
-    image = display_image_;
-    meta->generation = display_generation_;
-    meta->spp = display_spp_;
-    meta->spp_target = display_target_;
-    meta->pass_fraction = pass_fraction_;
-    meta->complete = display_spp_ >= display_target_ && pass_fraction_ == 0.0 && !display_awaits_denoise_;
-    meta->denoised = display_denoised_;
-    meta->frame_ms = last_pass_ms_;
-    if (accum_seconds_ > 0.0) {
-      meta->msamples_per_s = double(accum_samples_) / accum_seconds_ * 1e-6;
-      meta->mrays_per_s = double(accum_rays_) / accum_seconds_ * 1e-6;
-    }
-  }
-  const bool lossless = meta->complete;
-  publish_locked(std::move(image), std::move(meta), lossless);
-}
-
-void ViewSession::publish_image(Image8 image, std::shared_ptr<Frame> meta, bool lossless) {
-  const std::lock_guard publish(publish_mu_);
-  publish_locked(std::move(image), std::move(meta), lossless);
-}
-
-void ViewSession::publish_locked(Image8 image, std::shared_ptr<Frame> meta, bool lossless) {
-  meta->width = image.width;
-  meta->height = image.height;
-  // The finished image exactly (PNG: what `tracer render` writes); JPEG while it refines.
-  meta->mime = lossless ? "image/png" : "image/jpeg";
-  meta->bytes = lossless ? encode_png(image) : encode_jpeg(image, kJpegQuality);
-  frames_.publish(std::move(meta));
-  last_publish_ = Clock::now();
 }
 
 }  // namespace tracer::view

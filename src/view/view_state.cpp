@@ -44,12 +44,13 @@ void read_change(const nlohmann::json& change, StateFields& s, const frontend::R
       keys += r.key + ", ";
     }
     if (!row) throw UsageError("unknown field '" + key + "' (" + keys + "focus_at, denoise)");
+    // The viewer's own bound on a side first, so every width past it gets the same error.
+    if ((key == "width" || key == "height") && value.is_number_integer()) {
+      const auto side = value.get<long long>();
+      frontend::check_range(key, side, 1, kMaxViewSide);
+    }
     row->read_json(s.args, value);
     row->check(s.args, key);
-  }
-  for (const char* side : {"width", "height"}) {
-    const int v = side[0] == 'w' ? s.args.settings.width : s.args.settings.height;
-    frontend::check_range(side, v, 1, kMaxViewSide);
   }
   if (s.args.integrator != integrator) frontend::follow_integrator(s.args, launched);
 }

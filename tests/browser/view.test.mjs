@@ -172,7 +172,7 @@ try {
   await waitFor(() => window.tracerView.state().integrator === 'ao' && window.tracerView.state().spp === 4);
   await page.fill('#width', '0');
   await page.press('#width', 'Enter');
-  await waitFor(() => document.querySelector('#status').textContent.includes('width: must be between 1 and 16384, got 0'));
+  await waitFor(() => document.querySelector('#status').textContent.includes('width: must be between 1 and 4096, got 0'));
   await page.fill('#width', '150');
   await page.press('#width', 'Enter');
   await waitFor(() => window.tracerView.state().width === 150);
