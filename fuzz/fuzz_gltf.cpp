@@ -29,8 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (m >= scene.materials.size()) std::abort();
     }
     for (const tracer::Material& m : scene.materials) {
-      if (m.diffuse_texture != tracer::kInvalidIndex && m.diffuse_texture >= scene.textures.size()) std::abort();
-      if (m.normal_texture != tracer::kInvalidIndex && m.normal_texture >= scene.textures.size()) std::abort();
+      for (const tracer::TextureSlot* t : m.slots())
+        if (t->present() && (t->texture >= scene.textures.size() || t->uv_set > 1)) std::abort();
     }
   } catch (const tracer::InputError&) {
   }

@@ -95,7 +95,7 @@ TEST(Texture, MissingTextureWarnsOnceAndUsesKd) {
   EXPECT_NE(warnings[0].find("3 map_Kd texture(s) not used"), std::string::npos) << warnings[0];
   EXPECT_NE(warnings[0].find("nowhere.png"), std::string::npos) << warnings[0];
   EXPECT_TRUE(scene.textures.empty());
-  EXPECT_EQ(scene.materials[0].diffuse_texture, kInvalidIndex);
+  EXPECT_FALSE(scene.materials[0].diffuse_texture.present());
   EXPECT_EQ(scene.materials[0].kd, (Vec3{0.1f, 0.2f, 0.3f}));
 }
 

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "importers/gltf_loader.hpp"
 #include "math/rng.hpp"
 
 namespace tracer::test {
@@ -80,6 +81,30 @@ double psnr(const Image8& a, const Image8& b) {
   }
   mse /= double(a.rgb.size());
   return mse == 0.0 ? 1e9 : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+std::string gltf_load_error(const std::string& json) {
+  try {
+    load_gltf_from_memory(json, "t.gltf", [](const std::string&) {});
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+std::string base64(std::string_view bytes) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+    if (i + 2 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 2]));
+    out += k[(v >> 18) & 63];
+    out += k[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? k[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? k[v & 63] : '=';
+  }
+  return out;
 }
 
 std::string read_bytes(const std::string& path) {

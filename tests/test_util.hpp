@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "film/tone_map.hpp"
@@ -52,5 +54,17 @@ double chi_square_tail(const std::vector<double>& observed, const std::vector<do
 std::string temp_dir();
 // Every byte of a file (images compared byte for byte).
 std::string read_bytes(const std::string& path);
+
+// The one-line error of loading glTF text `json` as "t.gltf", or "(loaded)".
+std::string gltf_load_error(const std::string& json);
+// Base64 of `bytes` (a glTF data: URI's payload).
+std::string base64(std::string_view bytes);
+// The bytes of `values` as stored in memory (a glTF buffer's contents).
+template <class T>
+std::string bytes_of(std::initializer_list<T> values) {
+  std::string s;
+  for (T v : values) s.append(reinterpret_cast<const char*>(&v), sizeof v);
+  return s;
+}
 
 }  // namespace tracer::test

@@ -95,9 +95,13 @@ std::string first_line(const std::string& text) {
   return line.empty() ? "not a valid glTF file" : line;
 }
 
-const char* kSupportedExtensions[] = {
-    "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_specular",          "KHR_lights_punctual",        "KHR_mesh_quantization"};
+const char* kSupportedExtensions[] = {"KHR_materials_emissive_strength",
+                                      "KHR_materials_transmission",
+                                      "KHR_materials_ior",
+                                      "KHR_materials_specular",
+                                      "KHR_lights_punctual",
+                                      "KHR_mesh_quantization",
+                                      "KHR_texture_transform"};
 
 }  // namespace
 

@@ -300,6 +300,10 @@ class Checker {
           (*m)[15].get<double>() != 1.0) {
         throw error(at + ".matrix", "not affine (its last row is not 0 0 0 1): a node's matrix is a transform");
       }
+      // Not allowed beside a matrix, and what tinygltf then leaves unread: said, the matrix kept.
+      if (o.contains("translation") || o.contains("rotation") || o.contains("scale")) {
+        warnings_.add(at + ": both a matrix and translation/rotation/scale (not allowed): the matrix used");
+      }
     }
   }
 

@@ -1,6 +1,7 @@
 #include "importers/gltf_loader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -8,6 +9,8 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <string_view>
+#include <unordered_set>
 
 #include "base/memory_limit.hpp"
 #include "base/read_input.hpp"
@@ -96,11 +99,12 @@ class GltfScene {
     scene_.tri_material.reserve(total);
     if (any_attribute("NORMAL")) scene_.corner_normals.reserve(3 * total);
     if (any_attribute("TEXCOORD_0")) scene_.corner_uvs.reserve(3 * total);
+    if (any_attribute("TEXCOORD_1")) scene_.corner_uvs1.reserve(3 * total);
     scene_.geometries.reserve(primitives);
     if (instanced_) scene_.instances.reserve(instances);
     // Each node's own transform once: a shared node is walked once per path that reaches it.
     locals_.reserve(model_.nodes.size());
-    for (const tg::Node& node : model_.nodes) locals_.push_back(local_transform(node));
+    for (size_t i = 0; i < model_.nodes.size(); ++i) locals_.push_back(local_transform(model_.nodes[i], i, &warnings_));
     std::vector<char> on_path(model_.nodes.size(), 0);
     for (int root : roots)
       if (places_[size_t(root)]) visit(root, Affine{}, on_path, 0);
@@ -130,8 +134,9 @@ class GltfScene {
     f.triangles = f.instanced ? unique : all.triangles;
     f.primitives = f.instanced ? unique_primitives : all.primitives;
     f.instances = f.instanced ? all.instances : 0;
-    const bool normals = any_attribute("NORMAL"), uvs = any_attribute("TEXCOORD_0");
-    const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits_.accel_bytes_per_triangle;
+    const int uv_sets = int(any_attribute("TEXCOORD_0")) + int(any_attribute("TEXCOORD_1"));
+    const uint64_t per_triangle =
+        Scene::bytes_per_triangle(any_attribute("NORMAL"), uv_sets) + limits_.accel_bytes_per_triangle;
     constexpr uint64_t kPerPrimitive = sizeof(Geometry) + 32;  // and its name
     f.bytes = f.triangles >= kSaturated / per_triangle || f.primitives >= kSaturated / kPerPrimitive ||
                       f.instances >= kSaturated / kBytesPerInstance
@@ -299,8 +304,13 @@ class GltfScene {
     }
   }
 
-  static Affine local_transform(const tg::Node& n) {
-    if (n.matrix.size() == 16) return Affine::from_column_major(n.matrix.data());
+  // The specification's node transform. A zero quaternion, which it does not allow but exporters
+  // have written, is read as no rotation and said (into `warnings`, once per node).
+  static Affine local_transform(const tg::Node& n, size_t index = 0, WarningLog* warnings = nullptr) {
+    const auto warn = [&](const std::string& what) {
+      if (warnings) warnings->add("node " + std::to_string(index) + " " + what);
+    };
+    if (n.matrix.size() == 16) return Affine::from_column_major(n.matrix.data());  // TRS beside: gltf_json
     const double t[3] = {n.translation.size() == 3 ? n.translation[0] : 0.0,
                          n.translation.size() == 3 ? n.translation[1] : 0.0,
                          n.translation.size() == 3 ? n.translation[2] : 0.0};
@@ -308,8 +318,11 @@ class GltfScene {
     if (n.rotation.size() == 4) {
       const double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
                                    n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
-      if (len > 0.0)
+      if (len > 0.0) {
         for (int i = 0; i < 4; ++i) q[i] = n.rotation[size_t(i)] / len;
+      } else {
+        warn("has a zero rotation quaternion (not a rotation): read as none");
+      }
     }
     const double s[3] = {n.scale.size() == 3 ? n.scale[0] : 1.0, n.scale.size() == 3 ? n.scale[1] : 1.0,
                          n.scale.size() == 3 ? n.scale[2] : 1.0};
@@ -414,6 +427,19 @@ class GltfScene {
       throw error("mesh " + std::to_string(node.mesh) + " does not exist (the file has " +
                   std::to_string(model_.meshes.size()) + ")");
     }
+    // The same mesh placed again by the same transform, as traced (a node listed twice, nested
+    // identity nodes), is the same surface twice: it adds nothing to the image but a descent per
+    // ray and a tie at every hit, so it is placed once.
+    Placement placement{node.mesh, {}};
+    const Transform traced = Transform::of(world);
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 4; ++k) placement.m[size_t(4 * r + k)] = traced.m[r][k] + 0.0f;  // -0 as 0
+    if (!placements_.insert(placement).second) {
+      warnings_.add(
+          "meshes placed again by the same transform as an earlier placement (the same surface twice): "
+          "placed once");
+      return;
+    }
     if (node.skin >= 0) warnings_.add("skinned meshes are rendered as bound, unposed");
     if (instanced_) return add_instance(node.mesh, world);
     const tg::Mesh& m = model_.meshes[size_t(node.mesh)];
@@ -429,7 +455,7 @@ class GltfScene {
                     " triangles, more than tracer loads");
       }
       const size_t first = scene_.triangles.size();
-      append_mesh(scene_, m.name.empty() ? what : m.name, mesh, materials_.material(p.material, scene_), world);
+      append_mesh(scene_, m.name.empty() ? what : m.name, mesh, material_for(p, mesh, what), world);
       for (size_t t = first; t < scene_.triangles.size(); ++t) {
         const Triangle& tri = scene_.triangles[t];
         for (const Vec3& v : {tri.v0, tri.v1, tri.v2}) {
@@ -443,6 +469,18 @@ class GltfScene {
 
   // Instance mode: glTF mesh `mesh` as one scene mesh (its primitives appended once, in its own
   // space) and this placement of it.
+  // The scene material of primitive `p`, once its texture slots are known to read sets it has.
+  uint32_t material_for(const tg::Primitive& p, const IndexedMesh& mesh, const std::string& what) {
+    const uint32_t index = materials_.material(p.material, scene_);
+    const Material& m = scene_.materials[index];
+    for (const TextureSlot* t : m.slots()) {
+      if (t->present() && t->uv_set == 1 && mesh.uvs1.empty()) {
+        throw error(what + ": material " + in_quotes(m.name) + " reads TEXCOORD_1, which the primitive lacks");
+      }
+    }
+    return index;
+  }
+
   void add_instance(int mesh, const Affine& world) {
     auto [it, fresh] = scene_meshes_.try_emplace(mesh, kInvalidIndex);
     if (fresh) it->second = add_scene_mesh(mesh);
@@ -478,7 +516,7 @@ class GltfScene {
       if (fresh) it->second = gltf::primitive_mesh(model_, name_, warnings_, p, what);
       if (!it->second) continue;
       for (const Vec3& v : it->second->positions) box.extend(v);  // each within range (primitive_mesh)
-      append_mesh(scene_, m.name.empty() ? what : m.name, *it->second, materials_.material(p.material, scene_));
+      append_mesh(scene_, m.name.empty() ? what : m.name, *it->second, material_for(p, *it->second, what));
       it->second.reset();  // placed once: its arrays are the scene's now
     }
     const auto count = uint32_t(scene_.triangles.size() - first);
@@ -510,6 +548,19 @@ class GltfScene {
   std::map<int, uint32_t> scene_meshes_;                              // glTF mesh -> Scene::meshes index
   std::vector<Aabb> object_boxes_;                                    // per scene mesh, of its vertices
   std::vector<Affine> locals_;                                        // per node, its own transform
+  // Each mesh placed so far and its transform, as the renderer's floats.
+  struct Placement {
+    int mesh;
+    std::array<float, 12> m;
+    bool operator==(const Placement&) const = default;
+  };
+  struct PlacementHash {
+    size_t operator()(const Placement& p) const {
+      return std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(p.m.data()), sizeof p.m)) ^
+             (size_t(p.mesh) * 0x9e3779b97f4a7c15ull);
+    }
+  };
+  std::unordered_set<Placement, PlacementHash> placements_;
   std::vector<char> places_;  // per node: its subtree holds a mesh, camera or light
   gltf::Materials materials_;
 };

@@ -80,6 +80,7 @@ Material Materials::map_material(const tg::Material& g, int index) {
   // The dielectric reflectance at normal incidence: ((ior - 1) / (ior + 1))^2, 0.04 at 1.5.
   const float f0_ior = ior >= 1.0f ? ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f)) : 0.04f;
   const Vec3 f0 = min(specular_colour * f0_ior, Vec3{1.0f}) * std::max(specular_factor, 0.0f);
+  const std::string name = "material " + in_quotes(mat.name);
   Vec3 diffuse_tint{1.0f};
   if (transmitted > 0.0f) {
     if (transmitted < 1.0f) warnings_.add("partial transmission rendered as full transmission (glass)");
@@ -105,35 +106,111 @@ Material Materials::map_material(const tg::Material& g, int index) {
     }
   }
   if (pbr.baseColorTexture.index >= 0 && mat.illum == 2) {
-    mat.diffuse_texture =
-        texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, false, base * diffuse_tint);
+    mat.diffuse_texture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                  pbr.baseColorTexture.extensions, false, base * diffuse_tint,
+                                  name + " baseColorTexture");
   }
   if (g.normalTexture.index >= 0) {
-    mat.normal_texture = texture(g.normalTexture.index, g.normalTexture.texCoord, true, Vec3{1.0f});
+    mat.normal_texture = texture(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions, true,
+                                 Vec3{1.0f}, name + " normalTexture");
     mat.normal_scale = float(g.normalTexture.scale);
     if (!std::isfinite(mat.normal_scale)) throw error("material " + in_quotes(mat.name) + ": normal scale not finite");
   }
   return mat;
 }
 
-uint32_t Materials::texture(int index, int tex_coord, bool data, Vec3 tint) {
-  if (size_t(index) >= model_.textures.size()) throw error("texture " + std::to_string(index) + " does not exist");
+TextureSlot Materials::texture(int index, int tex_coord, const tg::ExtensionMap& info_extensions, bool data, Vec3 tint,
+                               const std::string& property) {
+  const std::string what = property + ".index";
+  if (index < 0 || size_t(index) >= model_.textures.size()) {
+    throw error(what + ": texture " + std::to_string(index) + " does not exist (the file has " +
+                std::to_string(model_.textures.size()) + ")");
+  }
   const tg::Texture& t = model_.textures[size_t(index)];
   if (t.source < 0 || size_t(t.source) >= model_.images.size()) {
     throw error("texture " + std::to_string(index) + ": image " + std::to_string(t.source) + " does not exist");
   }
-  if (tex_coord != 0) warnings_.add("texture coordinate sets other than TEXCOORD_0 not used: TEXCOORD_0 is");
-  if (t.sampler >= 0 && size_t(t.sampler) < model_.samplers.size()) {
-    const tg::Sampler& s = model_.samplers[size_t(t.sampler)];
-    if (s.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT || s.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT) {
-      warnings_.add("texture wrap modes other than repeat rendered as repeat");
-    }
+  TextureSlot slot;
+  if (const tg::Value* transform = extension(info_extensions, "KHR_texture_transform")) {
+    slot.transform = uv_transform(*transform, tex_coord, property);
   }
-  if (extension(t.extensions, "KHR_texture_transform")) warnings_.add("KHR_texture_transform not applied");
+  if (tex_coord < 0) throw error(property + ".texCoord: " + std::to_string(tex_coord) + " is negative");
+  if (tex_coord > 1) {
+    warnings_.add("texture coordinate sets past TEXCOORD_1 not read: TEXCOORD_0 used instead");
+    tex_coord = 0;
+  }
+  slot.uv_set = uint8_t(tex_coord);
+  slot.sampler = sampler(t.sampler);
   const TextureUse use{t.source, data, data ? Vec3{1.0f} : tint};
   const auto [it, fresh] = texture_slots_.try_emplace(use, uint32_t(texture_uses_.size()));
   if (fresh) texture_uses_.push_back(use);
-  return it->second;
+  slot.texture = it->second;
+  return slot;
+}
+
+Sampler Materials::sampler(int index) {
+  Sampler s;
+  if (index < 0) return s;
+  if (size_t(index) >= model_.samplers.size()) {
+    throw error("sampler " + std::to_string(index) + " does not exist (the file has " +
+                std::to_string(model_.samplers.size()) + ")");
+  }
+  const tg::Sampler& g = model_.samplers[size_t(index)];
+  const auto wrap = [&](int mode, const char* axis) {
+    switch (mode) {
+      case TINYGLTF_TEXTURE_WRAP_REPEAT:
+        return Wrap::Repeat;
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+        return Wrap::ClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+        return Wrap::MirroredRepeat;
+      default:
+        warnings_.add(std::string("sampler ") + axis + " of an unknown wrap mode: REPEAT used");
+        return Wrap::Repeat;
+    }
+  };
+  s.wrap_s = wrap(g.wrapS, "wrapS");
+  s.wrap_t = wrap(g.wrapT, "wrapT");
+  s.nearest = g.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+  // NEAREST and LINEAR minify from the full-resolution texels; the mip-map modes (and no filter
+  // given) from the pyramid, always blended linearly between two levels.
+  s.mipmaps = g.minFilter != TINYGLTF_TEXTURE_FILTER_NEAREST && g.minFilter != TINYGLTF_TEXTURE_FILTER_LINEAR;
+  return s;
+}
+
+// KHR_texture_transform's uv' = T(offset) R(rotation) S(scale) uv in glTF's v-down space, made the
+// same map of tracer's v-up coordinates (v = 1 - v_glTF on both sides); its texCoord replaces the
+// textureInfo's.
+UvTransform Materials::uv_transform(const tg::Value& t, int& tex_coord, const std::string& property) const {
+  const std::string where = property + ".extensions.KHR_texture_transform";
+  if (!t.IsObject()) throw error(where + ": not an object");
+  const auto pair = [&](const char* key, double fallback, double out[2]) {
+    out[0] = out[1] = fallback;
+    if (!t.Has(key)) return;
+    const tg::Value& v = t.Get(key);
+    if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber()) {
+      throw error(where + "." + key + ": not two numbers");
+    }
+    for (int k = 0; k < 2; ++k) out[k] = v.Get(k).GetNumberAsDouble();
+  };
+  double offset[2], scale[2];
+  pair("offset", 0.0, offset);
+  pair("scale", 1.0, scale);
+  const double rotation = number(&t, "rotation", 0.0);
+  for (double x : {offset[0], offset[1], scale[0], scale[1], rotation}) {
+    if (!std::isfinite(x) || std::fabs(x) > 1e6) throw error(where + ": a value not finite or beyond +-1e6");
+  }
+  if (scale[0] == 0.0 || scale[1] == 0.0) throw error(where + ".scale: zero (every point would read one texel row)");
+  if (t.Has("texCoord")) {
+    const tg::Value& c = t.Get("texCoord");
+    if (!c.IsInt()) throw error(where + ".texCoord: not an integer");
+    tex_coord = c.GetNumberAsInt();
+  }
+  const double cs = std::cos(rotation), sn = std::sin(rotation);
+  // glTF's map: u' = A u + B v + C, v' = D u + E v + F.
+  const double A = cs * scale[0], B = sn * scale[1], C = offset[0];
+  const double D = -sn * scale[0], E = cs * scale[1], F = offset[1];
+  return {float(A), float(-B), float(B + C), float(-D), float(E), float(1.0 - E - F)};
 }
 
 void Materials::attach_textures(Scene& scene) {
@@ -182,8 +259,8 @@ void Materials::attach_textures(Scene& scene) {
       warnings_.add("image " + std::to_string(images[k]) + " not used: " + batch.problem[k]);
   }
   for (Material& m : scene.materials) {
-    if (m.diffuse_texture != kInvalidIndex) m.diffuse_texture = slot_texture[m.diffuse_texture];
-    if (m.normal_texture != kInvalidIndex) m.normal_texture = slot_texture[m.normal_texture];
+    for (TextureSlot* t : m.slots())
+      if (t->present()) t->texture = slot_texture[t->texture];
   }
 }
 

@@ -48,8 +48,13 @@ class Materials {
 
   InputError error(const std::string& what) const { return InputError(name_ + ": " + what); }
   Material map_material(const tinygltf::Material& g, int index);
-  // A slot for texture `index` read as colour (tinted) or as data; filled by attach_textures().
-  uint32_t texture(int index, int tex_coord, bool data, Vec3 tint);
+  // The slot of texture `index` read through set `tex_coord` as colour (tinted) or as data, with
+  // its sampler and the textureInfo's KHR_texture_transform; its texture is a use of texture_uses_
+  // until attach_textures() makes it the scene's.
+  TextureSlot texture(int index, int tex_coord, const tinygltf::ExtensionMap& info_extensions, bool data, Vec3 tint,
+                      const std::string& property);
+  Sampler sampler(int index);
+  UvTransform uv_transform(const tinygltf::Value& t, int& tex_coord, const std::string& property) const;
   // An image's encoded bytes: from a buffer view, a data: URI (tinygltf decoded it) or a file
   // inside the scene's folder.
   EncodedTexture read_image(int index) const;

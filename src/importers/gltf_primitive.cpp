@@ -25,6 +25,13 @@ std::optional<IndexedMesh> primitive_mesh(const tg::Model& model_, const std::st
   if (pos == p.attributes.end()) throw error(what + ": no POSITION attribute");
   IndexedMesh mesh;
   const gltf::Elements positions = gltf::vectors(model_, pos->second, 3, where(what + " POSITION"));
+  if (positions.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+      std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_mesh_quantization") ==
+          model_.extensionsUsed.end()) {
+    warnings_.add(what +
+                  " POSITION: integer components without KHR_mesh_quantization in extensionsUsed: read as "
+                  "that extension defines them");
+  }
   mesh.positions.resize(positions.count);
   for (size_t i = 0; i < positions.count; ++i) {
     const Vec3 v{positions.get(i, 0), positions.get(i, 1), positions.get(i, 2)};
@@ -43,14 +50,16 @@ std::optional<IndexedMesh> primitive_mesh(const tg::Model& model_, const std::st
       mesh.normals[i] = is_finite(v) ? v : Vec3{0.0f};
     }
   }
-  if (const auto t = p.attributes.find("TEXCOORD_0"); t != p.attributes.end()) {
-    const gltf::Elements uvs = gltf::vectors(model_, t->second, 2, where(what + " TEXCOORD_0"));
-    if (uvs.count != positions.count) throw error(what + ": TEXCOORD_0 and POSITION counts differ");
-    mesh.uvs.resize(uvs.count);
+  for (const auto& [set, out] : {std::pair{"TEXCOORD_0", &mesh.uvs}, std::pair{"TEXCOORD_1", &mesh.uvs1}}) {
+    const auto t = p.attributes.find(set);
+    if (t == p.attributes.end()) continue;
+    const gltf::Elements uvs = gltf::vectors(model_, t->second, 2, where(what + " " + set));
+    if (uvs.count != positions.count) throw error(what + ": " + set + " and POSITION counts differ");
+    out->resize(uvs.count);
     for (size_t i = 0; i < uvs.count; ++i) {
       const float u = uvs.get(i, 0), v = uvs.get(i, 1);
       // glTF's v runs down the image, OBJ's (and tracer's) up.
-      mesh.uvs[i] = std::isfinite(u) && std::isfinite(v) ? Vec2{u, 1.0f - v} : Vec2{};
+      (*out)[i] = std::isfinite(u) && std::isfinite(v) ? Vec2{u, 1.0f - v} : Vec2{};
     }
   }
   if (p.attributes.count("COLOR_0")) warnings_.add("vertex colours (COLOR_0) not used");

@@ -38,13 +38,15 @@ void append_mesh(Scene& scene, const std::string& name, const IndexedMesh& mesh,
         for (int k = 0; k < 3; ++k) scene.corner_normals[3 * (first + t) + k] = turned[mesh.indices[3 * t + corner[k]]];
     }
   }
-  if (!mesh.uvs.empty() || !scene.corner_uvs.empty()) {
-    scene.corner_uvs.resize(3 * (first + count), Vec2{});
-    if (!mesh.uvs.empty()) {
-      for (size_t t = 0; t < count; ++t)
-        for (int k = 0; k < 3; ++k) scene.corner_uvs[3 * (first + t) + k] = mesh.uvs[mesh.indices[3 * t + corner[k]]];
-    }
-  }
+  const auto place_uvs = [&](const std::vector<Vec2>& uvs, LargeVector<Vec2>& corners) {
+    if (uvs.empty() && corners.empty()) return;
+    corners.resize(3 * (first + count), Vec2{});
+    if (uvs.empty()) return;
+    for (size_t t = 0; t < count; ++t)
+      for (int k = 0; k < 3; ++k) corners[3 * (first + t) + k] = uvs[mesh.indices[3 * t + corner[k]]];
+  };
+  place_uvs(mesh.uvs, scene.corner_uvs);
+  place_uvs(mesh.uvs1, scene.corner_uvs1);
   scene.vertex_count += mesh.positions.size();
   scene.geometries.push_back({name, uint32_t(first), uint32_t(count)});
 }

@@ -296,7 +296,7 @@ void add_materials(Scene& scene, const Layout& layout, MaterialTextures textures
   for (size_t i = 0; i < layout.materials.size(); ++i) {
     const MtlMaterial& m = layout.materials[i];
     Material mat = to_material(m, name);
-    uint32_t* slot[2] = {&mat.diffuse_texture, &mat.bump_texture};
+    uint32_t* slot[2] = {&mat.diffuse_texture.texture, &mat.bump_texture.texture};
     const std::string* map[2] = {&m.diffuse_map, &m.bump_map};
     for (size_t k = 0; k < 2; ++k) {
       std::string why = problem[2 * i + k];

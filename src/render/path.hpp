@@ -15,8 +15,8 @@
 #include "math/sobol.hpp"
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
-#include "render/texture_lookup.hpp"
 #include "shade/material_bsdf.hpp"
+#include "shade/texture_lookup.hpp"
 
 namespace tracer {
 

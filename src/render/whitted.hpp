@@ -4,8 +4,8 @@
 
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
-#include "render/texture_lookup.hpp"
 #include "shade/optics.hpp"
+#include "shade/texture_lookup.hpp"
 
 namespace tracer {
 

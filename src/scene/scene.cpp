@@ -33,6 +33,7 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
   vertex_count += vertices.size();
   if (!corner_normals.empty()) corner_normals.resize(3 * triangles.size(), Vec3{0.0f});  // none for this mesh
   if (!corner_uvs.empty()) corner_uvs.resize(3 * triangles.size(), Vec2{});
+  if (!corner_uvs1.empty()) corner_uvs1.resize(3 * triangles.size(), Vec2{});
   geometries.push_back(std::move(g));
 }
 
@@ -141,7 +142,8 @@ void Scene::finalize() {
 uint64_t Scene::memory_bytes() const {
   uint64_t bytes = triangles.capacity() * sizeof(Triangle) +
                    (tri_geom.capacity() + tri_prim.capacity() + tri_material.capacity()) * sizeof(uint32_t) +
-                   corner_normals.capacity() * sizeof(Vec3) + corner_uvs.capacity() * sizeof(Vec2) +
+                   corner_normals.capacity() * sizeof(Vec3) +
+                   (corner_uvs.capacity() + corner_uvs1.capacity()) * sizeof(Vec2) +
                    geometries.capacity() * sizeof(Geometry) + emitters.memory_bytes() +
                    meshes.capacity() * sizeof(Mesh) + instances.capacity() * sizeof(Instance);
   for (const Texture& t : textures) bytes += t.srgb().size() * 4 / 3;  // and its mip levels

@@ -2,6 +2,7 @@
 // an optional camera the scene suggests.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -50,17 +51,20 @@ struct Material {
   float ns = 0.0f;
   float ni = 1.0f;
   int illum = 2;
-  // map_Kd: an index into Scene::textures, or kInvalidIndex. Where present it replaces Kd (the
-  // exporters' convention: Sponza's Kd is its texture's mean, so a product would darken it twice).
-  uint32_t diffuse_texture = kInvalidIndex;
-  // map_bump / bump: a height map (an index into Scene::textures, or kInvalidIndex) whose values
-  // in [0, 1] times bump_multiplier (-bm) displace the surface along its normal, in scene units.
-  uint32_t bump_texture = kInvalidIndex;
+  // map_Kd, glTF's baseColorTexture: where present it replaces Kd (the exporters' convention:
+  // Sponza's Kd is its texture's mean, so a product would darken it twice).
+  TextureSlot diffuse_texture;
+  // map_bump / bump: a height map whose values in [0, 1] times bump_multiplier (-bm) displace the
+  // surface along its normal, in scene units.
+  TextureSlot bump_texture;
   float bump_multiplier = 1.0f;
-  // glTF's normalTexture: a tangent-space normal map (an index into Scene::textures, or
-  // kInvalidIndex; its bytes as data, x along +u, y along +v), its x and y scaled by normal_scale.
-  uint32_t normal_texture = kInvalidIndex;
+  // glTF's normalTexture: a tangent-space normal map (its bytes as data, x along +u, y along +v),
+  // its x and y scaled by normal_scale.
+  TextureSlot normal_texture;
   float normal_scale = 1.0f;
+  // Every slot, for what treats them alike (the importers' index remapping and checks).
+  std::array<TextureSlot*, 3> slots() { return {&diffuse_texture, &bump_texture, &normal_texture}; }
+  std::array<const TextureSlot*, 3> slots() const { return {&diffuse_texture, &bump_texture, &normal_texture}; }
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
   // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.
@@ -109,8 +113,10 @@ struct Scene {
   // none; zero at the corners of faces that give none. The ao workload shades with the geometric
   // normal; whitted interpolates these.
   LargeVector<Vec3> corner_normals;
-  // Texture coordinates from the file's `vt`, three per triangle, or empty when it has none.
+  // Texture coordinates from the file's `vt` (glTF's TEXCOORD_0), three per triangle, or empty
+  // when it has none; corner_uvs1 the second set (TEXCOORD_1), read by slots whose uv_set is 1.
   LargeVector<Vec2> corner_uvs;
+  LargeVector<Vec2> corner_uvs1;
   std::vector<Texture> textures;
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
@@ -157,9 +163,10 @@ struct Scene {
   // The bytes its arrays and textures hold (an estimate of what it occupies).
   uint64_t memory_bytes() const;
   // Per triangle: its corners, ids and material, and its corners' normals and texture coordinates
-  // where the scene has them.
-  static constexpr uint64_t bytes_per_triangle(bool normals, bool uvs) {
-    return sizeof(Triangle) + 3 * sizeof(uint32_t) + (normals ? 3 * sizeof(Vec3) : 0) + (uvs ? 3 * sizeof(Vec2) : 0);
+  // (of `uv_sets` sets) where the scene has them.
+  static constexpr uint64_t bytes_per_triangle(bool normals, int uv_sets) {
+    return sizeof(Triangle) + 3 * sizeof(uint32_t) + (normals ? 3 * sizeof(Vec3) : 0) +
+           uint64_t(uv_sets) * 3 * sizeof(Vec2);
   }
   // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials
   // (each instance of an emissive mesh its own lights).

@@ -41,17 +41,30 @@ uint64_t scene_checksum(const Scene& scene) {
   h.array(scene.tri_material);
   h.array(scene.corner_normals);
   h.array(scene.corner_uvs);
+  if (!scene.corner_uvs1.empty()) h.array(scene.corner_uvs1);  // scenes without keep their checksums
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     for (const Vec3& c : {m.kd, m.ks, m.ke, m.tf}) h.value(c);
     h.value(m.ns);
     h.value(m.ni);
     h.value(m.illum);
-    h.value(m.diffuse_texture);
-    h.value(m.bump_texture);
+    // Each slot's texture; how it addresses it only where that is not the default, so scenes
+    // with plain slots keep the checksums they had.
+    const auto slot = [&](const TextureSlot& t) {
+      h.value(t.texture);
+      if (t.uv_set != 0 || !(t.sampler == Sampler{}) || !t.transform.identity()) {
+        h.value(t.uv_set);
+        h.value(int(t.sampler.wrap_s) | int(t.sampler.wrap_t) << 4 | int(t.sampler.nearest) << 8 |
+                int(t.sampler.mipmaps) << 9);
+        for (float x : {t.transform.a, t.transform.b, t.transform.c, t.transform.d, t.transform.e, t.transform.f})
+          h.value(x);
+      }
+    };
+    slot(m.diffuse_texture);
+    slot(m.bump_texture);
     h.value(m.bump_multiplier);
-    if (m.normal_texture != kInvalidIndex) {  // glTF's; OBJ scenes keep the checksums they had
-      h.value(m.normal_texture);
+    if (m.normal_texture.present()) {  // glTF's; OBJ scenes keep the checksums they had
+      slot(m.normal_texture);
       h.value(m.normal_scale);
     }
   }

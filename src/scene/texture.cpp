@@ -86,24 +86,59 @@ Vec3 Texture::texel(int x, int y) const {
 namespace {
 
 // The four texels around (u, v) and their weights: texel centres sit at half-integers; v runs up
-// the image, rows run down; coordinates repeat.
+// the image, rows run down. `nearest`: one texel, the four indices equal and no blend.
 struct Footprint {
   int x0, x1, y0, y1;
   float ax, ay;
 };
 
-Footprint footprint(float u, float v, int width, int height) {
-  const float fx = (u - std::floor(u)) * float(width) - 0.5f;
-  const float fy = (1.0f - (v - std::floor(v))) * float(height) - 0.5f;
-  const float x0f = std::floor(fx), y0f = std::floor(fy);
-  // fx lies in [-0.5, width - 0.5), so x0 in [-1, width - 1]: one compare wraps each side.
-  const auto wrap = [](int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); };
-  return {wrap(int(x0f), width),
-          wrap(int(x0f) + 1, width),
-          wrap(int(y0f), height),
-          wrap(int(y0f) + 1, height),
-          fx - x0f,
-          fy - y0f};
+// A coordinate along an axis in [0, 1) of the image's width (u) or its rows from the top (t),
+// reduced as the wrap mode reads it: [0, 1) for repeat, [0, 2) for a mirrored repeat (the second
+// half read backwards by wrap_index), as given for clamp. Non-finite coordinates read 0.
+float reduce(float x, Wrap w) {
+  if (!std::isfinite(x)) return 0.0f;
+  switch (w) {
+    case Wrap::Repeat:
+      return x - std::floor(x);
+    case Wrap::MirroredRepeat:
+      return x - 2.0f * std::floor(0.5f * x);
+    case Wrap::ClampToEdge:
+      break;
+  }
+  return std::clamp(x, -1.0f, 2.0f);  // beyond, every index clamps to the same edge
+}
+
+// Texel index i of an axis of n texels as the wrap mode reads it: i lies within a texel or two
+// of what reduce() bounds it to.
+int wrap_index(int i, int n, Wrap w) {
+  switch (w) {
+    case Wrap::Repeat:
+      return i < 0 ? i + n : (i >= n ? i - n : i);
+    case Wrap::MirroredRepeat:
+      i = i < 0 ? i + 2 * n : (i >= 2 * n ? i - 2 * n : i);
+      return i >= n ? 2 * n - 1 - i : i;
+    case Wrap::ClampToEdge:
+      break;
+  }
+  return std::clamp(i, 0, n - 1);
+}
+
+Footprint footprint(float u, float v, int width, int height, const Sampler& s) {
+  // Rows run down from v = 1. Repeat reduces v itself (the images before samplers, bit for bit).
+  const float t = s.wrap_t == Wrap::Repeat ? 1.0f - reduce(v, Wrap::Repeat) : reduce(1.0f - v, s.wrap_t);
+  const float fx = reduce(u, s.wrap_s) * float(width), fy = t * float(height);
+  if (s.nearest) {
+    const int x = wrap_index(int(std::floor(fx)), width, s.wrap_s),
+              y = wrap_index(int(std::floor(fy)), height, s.wrap_t);
+    return {x, x, y, y, 0.0f, 0.0f};
+  }
+  const float x0f = std::floor(fx - 0.5f), y0f = std::floor(fy - 0.5f);
+  return {wrap_index(int(x0f), width, s.wrap_s),
+          wrap_index(int(x0f) + 1, width, s.wrap_s),
+          wrap_index(int(y0f), height, s.wrap_t),
+          wrap_index(int(y0f) + 1, height, s.wrap_t),
+          fx - 0.5f - x0f,
+          fy - 0.5f - y0f};
 }
 
 // The bilinear blend of what `at(x, y)` gives at the footprint's four texels.
@@ -115,9 +150,9 @@ auto blend(const Footprint& f, const At& at) {
 
 }  // namespace
 
-float Texture::height(float u, float v) const {
+float Texture::height(float u, float v, const Sampler& s) const {
   if (width_ == 0 || height_ == 0) return 0.0f;
-  const Footprint f = footprint(u, v, width_, height_);
+  const Footprint f = footprint(u, v, width_, height_, s);
   return blend(f, [&](int x, int y) {
     const uint8_t* p = &srgb_[3 * (size_t(y) * size_t(width_) + size_t(x))];
     return float(int(p[0]) + int(p[1]) + int(p[2])) * (1.0f / 765.0f);
@@ -134,17 +169,17 @@ Texture Texture::tinted(Vec3 factor) const {
   return Texture(width_, height_, std::move(out));
 }
 
-Vec3 Texture::data(float u, float v) const {
+Vec3 Texture::data(float u, float v, const Sampler& s) const {
   if (width_ == 0 || height_ == 0) return Vec3{0.0f};
-  const Footprint f = footprint(u, v, width_, height_);
+  const Footprint f = footprint(u, v, width_, height_, s);
   return blend(f, [&](int x, int y) {
     const uint8_t* p = &srgb_[3 * (size_t(y) * size_t(width_) + size_t(x))];
     return Vec3{float(p[0]), float(p[1]), float(p[2])} * (1.0f / 255.0f);
   });
 }
 
-Vec3 Texture::bilinear_at(const Level& level, float u, float v) const {
-  const Footprint f = footprint(u, v, level.width, level.height);
+Vec3 Texture::bilinear_at(const Level& level, float u, float v, const Sampler& s) const {
+  const Footprint f = footprint(u, v, level.width, level.height, s);
   const auto& lut = kSrgbToLinear;
   return blend(f, [&](int x, int y) {
     const uint8_t* p = &level.srgb[(size_t(y) * size_t(level.width) + size_t(x)) * 3];
@@ -152,20 +187,23 @@ Vec3 Texture::bilinear_at(const Level& level, float u, float v) const {
   });
 }
 
-Vec3 Texture::filtered(float u, float v, float lod) const {
-  if (!(lod > 0.0f) || mips_.empty()) return bilinear(u, v);
+Vec3 Texture::filtered(float u, float v, float lod, const Sampler& s) const {
+  if (!(lod > 0.0f) || mips_.empty() || !s.mipmaps) return bilinear(u, v, s);
+  // Minified: the levels blend linearly (a nearest magnification filter does not apply).
+  Sampler linear = s;
+  linear.nearest = false;
   const float top = float(mips_.size());
-  if (lod >= top) return bilinear_at(mips_.back(), u, v);
+  if (lod >= top) return bilinear_at(mips_.back(), u, v, linear);
   const int l = int(lod);
   const float a = lod - float(l);
-  const Vec3 lo = l == 0 ? bilinear(u, v) : bilinear_at(mips_[size_t(l) - 1], u, v);
-  const Vec3 hi = bilinear_at(mips_[size_t(l)], u, v);
+  const Vec3 lo = l == 0 ? bilinear(u, v, linear) : bilinear_at(mips_[size_t(l) - 1], u, v, linear);
+  const Vec3 hi = bilinear_at(mips_[size_t(l)], u, v, linear);
   return lo * (1.0f - a) + hi * a;
 }
 
-Vec3 Texture::bilinear(float u, float v) const {
+Vec3 Texture::bilinear(float u, float v, const Sampler& s) const {
   if (width_ == 0 || height_ == 0) return Vec3{0.0f};
-  return blend(footprint(u, v, width_, height_), [&](int x, int y) { return texel(x, y); });
+  return blend(footprint(u, v, width_, height_, s), [&](int x, int y) { return texel(x, y); });
 }
 
 namespace {

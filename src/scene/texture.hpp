@@ -1,5 +1,6 @@
-// Image textures (the MTL's map_Kd): 8-bit sRGB texels as stored in the file, decoded to linear
-// at lookup through a table, filtered bilinearly, repeating outside [0, 1).
+// Image textures (the MTL's maps, glTF's images): 8-bit sRGB texels as stored in the file, decoded
+// to linear at lookup through a table, filtered and wrapped as a Sampler says (bilinear and
+// repeating by default).
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 
 #include "base/errors.hpp"
 #include "math/vec.hpp"
+#include "scene/texture_slot.hpp"
 
 namespace tracer {
 
@@ -21,23 +23,24 @@ class Texture {
   int width() const { return width_; }
   int height() const { return height_; }
   // Linear colour at texture coordinates (u, v) as OBJ gives them: v = 0 is the image's bottom
-  // row. Bilinear between the four nearest texel centres; coordinates wrap.
-  Vec3 bilinear(float u, float v) const;
+  // row. Bilinear between the four nearest texel centres (the nearest texel where the sampler
+  // says so); coordinates wrap as the sampler says.
+  Vec3 bilinear(float u, float v, const Sampler& s = {}) const;
   // The same filtered to level of detail `lod` (0: the texels; each level halves the resolution,
   // its texels the mean of 2 x 2 of the level below, averaged in linear light): trilinear, between
-  // the two levels around lod; lod <= 0 is bilinear().
-  Vec3 filtered(float u, float v, float lod) const;
+  // the two levels around lod; lod <= 0, or a sampler without mip-maps, is bilinear().
+  Vec3 filtered(float u, float v, float lod, const Sampler& s = {}) const;
   int levels() const { return 1 + int(mips_.size()); }
   // The linear colour of texel (x, y), rows from the top.
   Vec3 texel(int x, int y) const;
   // A bump map's height in [0, 1] at (u, v): the stored bytes as data (no sRGB decoding), the
-  // mean of the channels, filtered bilinearly with repeat as bilinear() is.
-  float height(float u, float v) const;
+  // mean of the channels, filtered and wrapped as bilinear() is.
+  float height(float u, float v, const Sampler& s = {}) const;
   // The texture with each texel's linear colour times `factor` (clamped to 1): glTF's
   // baseColorFactor folded into its baseColorTexture.
   Texture tinted(Vec3 factor) const;
-  // The stored bytes as data in [0, 1] (a normal map's), filtered bilinearly with repeat.
-  Vec3 data(float u, float v) const;
+  // The stored bytes as data in [0, 1] (a normal map's), filtered and wrapped as bilinear() is.
+  Vec3 data(float u, float v, const Sampler& s = {}) const;
   // The texels as stored: 8-bit sRGB, RGB, rows from the top.
   const std::vector<uint8_t>& srgb() const { return srgb_; }
 
@@ -46,7 +49,7 @@ class Texture {
     int width, height;
     std::vector<uint8_t> srgb;
   };
-  Vec3 bilinear_at(const Level& level, float u, float v) const;
+  Vec3 bilinear_at(const Level& level, float u, float v, const Sampler& s) const;
   int width_ = 0, height_ = 0;
   std::vector<uint8_t> srgb_;
   std::vector<Level> mips_;  // levels 1, 2, ... down to 1 x 1 (level 0 is srgb_)

@@ -1,5 +1,6 @@
-// What the textures say at a hit: the diffuse colour filtered to the ray's footprint (ray cones
-// and the texture level of detail) and the shading normal moved by the bump map.
+// What the textures say at a hit: each slot's coordinates (its set, its transform), the diffuse
+// colour filtered to the ray's footprint (ray cones and the texture level of detail) and the
+// shading normal moved by the bump map.
 #pragma once
 
 #include <algorithm>
@@ -16,6 +17,17 @@ inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
   return {c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, c[0].y * w + c[1].y * hit.u + c[2].y * hit.v};
 }
 
+// The corners' coordinates that `slot` reads on scene triangle `tri`: its set's, moved by its
+// transform. False where the slot is empty or the scene has no such set.
+inline bool slot_corners(const Scene& scene, uint32_t tri, const TextureSlot& slot, Vec2 out[3]) {
+  if (!slot.present()) return false;
+  const LargeVector<Vec2>& set = slot.uv_set == 1 ? scene.corner_uvs1 : scene.corner_uvs;
+  if (set.empty()) return false;
+  const Vec2* c = &set[3 * size_t(tri)];
+  for (int k = 0; k < 3; ++k) out[k] = slot.transform.identity() ? c[k] : slot.transform.apply(c[k]);
+  return true;
+}
+
 // The shading normal `ns` moved by the material's normal map or bump map. A normal map (glTF's
 // normalTexture) gives the normal in the frame of the tangent dp/du made perpendicular to ns,
 // the bitangent on dp/dv's side and ns (per-triangle tangents, as glTF prescribes where a mesh
@@ -26,10 +38,11 @@ inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
 // A normal that would face away from the viewer `wo` (where the BSDF would return black: the
 // fringes of shading normals) is tilted back until it faces it, just.
 inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& mat, Vec3 ns, Vec3 wo) {
-  const bool normal_map = mat.normal_texture != kInvalidIndex;
-  if ((!normal_map && mat.bump_texture == kInvalidIndex) || scene.corner_uvs.empty()) return ns;
+  const bool normal_map = mat.normal_texture.present();
+  const TextureSlot& slot = normal_map ? mat.normal_texture : mat.bump_texture;
+  Vec2 c[3];
+  if (!slot_corners(scene, hit.tri, slot, c)) return ns;
   const Triangle tri = scene.world_triangle(hit.tri, hit.inst);
-  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float du1 = c[1].x - c[0].x, dv1 = c[1].y - c[0].y, du2 = c[2].x - c[0].x, dv2 = c[2].y - c[0].y;
   const float det = du1 * dv2 - dv1 * du2;
   if (!(std::fabs(det) > 1e-20f)) return ns;  // degenerate texture coordinates: no tangents
@@ -43,13 +56,14 @@ inline Vec3 bumped_normal(const Scene& scene, const Hit& hit, const Material& ma
     if (!(t_len > 0.0f) || !std::isfinite(t_len)) return ns;
     const Vec3 t = t_raw / t_len;
     const Vec3 b = dot(cross(ns, t), dpdv) < 0.0f ? -cross(ns, t) : cross(ns, t);
-    const Vec3 m = scene.textures[mat.normal_texture].data(u, v) * 2.0f - Vec3{1.0f};
+    const Vec3 m = scene.textures[slot.texture].data(u, v, slot.sampler) * 2.0f - Vec3{1.0f};
     n = t * (m.x * mat.normal_scale) + b * (m.y * mat.normal_scale) + ns * m.z;
   } else {
-    const Texture& tex = scene.textures[mat.bump_texture];
+    const Texture& tex = scene.textures[slot.texture];
+    const Sampler& sm = slot.sampler;
     const float hu = 0.5f / float(tex.width()), hv = 0.5f / float(tex.height());
-    const float dhdu = (tex.height(u + hu, v) - tex.height(u - hu, v)) / (2.0f * hu) * mat.bump_multiplier;
-    const float dhdv = (tex.height(u, v + hv) - tex.height(u, v - hv)) / (2.0f * hv) * mat.bump_multiplier;
+    const float dhdu = (tex.height(u + hu, v, sm) - tex.height(u - hu, v, sm)) / (2.0f * hu) * mat.bump_multiplier;
+    const float dhdv = (tex.height(u, v + hv, sm) - tex.height(u, v - hv, sm)) / (2.0f * hv) * mat.bump_multiplier;
     n = cross(dpdu + ns * dhdu, dpdv + ns * dhdv);
   }
   const float len = length(n);
@@ -75,10 +89,10 @@ struct RayCone {
 
 // The texture level of detail of a cone of width `width` meeting the hit triangle at incidence
 // cosine `cos_incidence`: log2 of the texels its footprint spans, through the triangle's ratio of
-// texture area (in texels) to surface area.
-inline float texture_lod(const Scene& scene, const Hit& hit, const Texture& t, float width, float cos_incidence) {
+// texture area (in texels; corners `c` as the slot reads them) to surface area.
+inline float texture_lod(const Scene& scene, const Hit& hit, const Vec2* c, const Texture& t, float width,
+                         float cos_incidence) {
   const Triangle tri = scene.world_triangle(hit.tri, hit.inst);
-  const Vec2* c = &scene.corner_uvs[3 * size_t(hit.tri)];
   const float texels = std::fabs((c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y)) *
                        float(t.width()) * float(t.height());
   const float area = length(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
@@ -86,17 +100,34 @@ inline float texture_lod(const Scene& scene, const Hit& hit, const Texture& t, f
   return std::isfinite(lod) ? lod : 0.0f;
 }
 
-// The diffuse colour at a hit: the material's map_Kd texture at the interpolated texture
-// coordinates, filtered to the footprint of `cone` at the hit (trilinearly between mip levels;
-// bilinearly from the texels where the cone is inactive), where it has one and the triangle has
-// coordinates; else Kd. `cos_incidence`: |cos| of the ray with the surface.
+// A colour slot's linear texel at a hit, filtered to the footprint of `cone` (trilinearly between
+// mip levels; from the texels where the cone is inactive) and addressed as the slot says; or
+// `otherwise` where the slot is empty or the triangle has no such coordinates.
+inline Vec3 slot_color(const Scene& scene, const Hit& hit, const TextureSlot& slot, Vec3 otherwise,
+                       const RayCone& cone = {}, float cos_incidence = 1.0f) {
+  Vec2 c[3];
+  if (!slot_corners(scene, hit.tri, slot, c)) return otherwise;
+  const auto [u, v] = hit_uv(c, hit);
+  const Texture& t = scene.textures[slot.texture];
+  if (!cone.active()) return t.bilinear(u, v, slot.sampler);
+  return t.filtered(u, v, texture_lod(scene, hit, c, t, cone.width_at(hit.t), cos_incidence), slot.sampler);
+}
+
+// A data slot's values in [0, 1] at a hit (the stored bytes, no sRGB decoding: glTF's
+// metallicRoughnessTexture), bilinear at full resolution as normal maps are read; `otherwise`
+// where the slot is empty or the triangle has no such coordinates.
+inline Vec3 slot_data(const Scene& scene, const Hit& hit, const TextureSlot& slot, Vec3 otherwise) {
+  Vec2 c[3];
+  if (!slot_corners(scene, hit.tri, slot, c)) return otherwise;
+  const auto [u, v] = hit_uv(c, hit);
+  return scene.textures[slot.texture].data(u, v, slot.sampler);
+}
+
+// The diffuse colour at a hit: the material's map_Kd (baseColorTexture), else Kd.
+// `cos_incidence`: |cos| of the ray with the surface.
 inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat, const RayCone& cone = {},
                           float cos_incidence = 1.0f) {
-  if (mat.diffuse_texture == kInvalidIndex || scene.corner_uvs.empty()) return mat.kd;
-  const auto [u, v] = hit_uv(&scene.corner_uvs[3 * size_t(hit.tri)], hit);
-  const Texture& t = scene.textures[mat.diffuse_texture];
-  if (!cone.active()) return t.bilinear(u, v);
-  return t.filtered(u, v, texture_lod(scene, hit, t, cone.width_at(hit.t), cos_incidence));
+  return slot_color(scene, hit, mat.diffuse_texture, mat.kd, cone, cos_incidence);
 }
 
 }  // namespace tracer
