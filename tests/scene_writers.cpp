@@ -106,6 +106,18 @@ tg::Material to_gltf(const Material& mat) {
       g.extensions["KHR_materials_ior"] = object({{"ior", tg::Value(double(mat.ni))}});
       pbr.roughnessFactor = 0.0;
       break;
+    case SurfaceKind::MetallicRoughness:
+      pbr.baseColorFactor = rgb(mat.kd);
+      pbr.metallicFactor = mat.metallic;
+      pbr.roughnessFactor = mat.roughness;
+      if (mat.specular_f90 != 1.0f || !(mat.specular_f0 == Vec3{0.04f})) {
+        const Vec3 c = mat.specular_f0 / (0.04f * std::max(mat.specular_f90, 1e-6f));
+        g.extensions["KHR_materials_specular"] = object(
+            {{"specularFactor", tg::Value(double(mat.specular_f90))},
+             {"specularColorFactor",
+              tg::Value(tg::Value::Array{tg::Value(double(c.x)), tg::Value(double(c.y)), tg::Value(double(c.z))})}});
+      }
+      break;
     case SurfaceKind::Diffuse: {
       pbr.baseColorFactor = rgb(mat.kd);
       const Vec3 ks = mat.illum >= 2 ? mat.ks : Vec3{0.0f};

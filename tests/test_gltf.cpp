@@ -68,10 +68,14 @@ TEST(Gltf, OneTriangleLoadsWithItsMaterial) {
   ASSERT_EQ(s.triangles.size(), 1u);
   EXPECT_EQ(s.triangles[0].v1, (Vec3{1, 0, 0}));
   ASSERT_EQ(s.materials.size(), 1u);
-  // Dielectric base: diffuse = base colour, specular F0 0.04, roughness 1 (the default).
-  EXPECT_EQ(s.materials[0].kd, (Vec3{0.5f, 0.25f, 1.0f}));
-  EXPECT_NEAR(s.materials[0].ks.x, 0.04f, 1e-7f);
-  EXPECT_EQ(s.materials[0].illum, 2);
+  // The metallic-roughness BRDF: a dielectric (metallicFactor 0), roughness 1 (the default).
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.surface(), SurfaceKind::MetallicRoughness);
+  EXPECT_EQ(m.kd, (Vec3{0.5f, 0.25f, 1.0f}));
+  EXPECT_EQ(m.metallic, 0.0f);
+  EXPECT_EQ(m.roughness, 1.0f);
+  EXPECT_NEAR(m.specular_f0.x, 0.04f, 1e-7f);
+  EXPECT_EQ(m.specular_f90, 1.0f);
 }
 
 TEST(Gltf, NodeTransformsComposeAndAMirrorKeepsTheFrontFace) {
@@ -140,10 +144,19 @@ TEST(Gltf, MetallicRoughnessMapsAsDocumented) {
   g.material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1], "metallicFactor": 0.5,
                    "roughnessFactor": 0.5}})";
   s = load_gltf_from_memory(g.json(), "t.gltf");
-  EXPECT_EQ(s.materials[0].kd, (Vec3{0.4f, 0.3f, 0.2f}));
-  EXPECT_NEAR(s.materials[0].ks.x, 0.5f * 0.04f + 0.5f * 0.8f, 1e-6f);
-  // alpha = roughness^2 = 0.25; tracer's Phong exponent 2 / alpha^2 - 2 maps back to it.
-  EXPECT_NEAR(s.materials[0].ns, 30.0f, 1e-3f);
+  EXPECT_EQ(s.materials[0].surface(), SurfaceKind::MetallicRoughness);
+  EXPECT_EQ(s.materials[0].kd, (Vec3{0.8f, 0.6f, 0.4f}));  // the BRDF mixes metal and dielectric itself
+  EXPECT_EQ(s.materials[0].metallic, 0.5f);
+  EXPECT_EQ(s.materials[0].roughness, 0.5f);
+  // KHR_materials_specular: F0 = 0.04 x colour x factor, F90 = the factor.
+  g.extra = R"("extensionsUsed": ["KHR_materials_specular"], )";
+  g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0}, "extensions": {"KHR_materials_specular":
+                   {"specularFactor": 0.5, "specularColorFactor": [1, 0.5, 2]}}})";
+  s = load_gltf_from_memory(g.json(), "t.gltf");
+  EXPECT_NEAR(s.materials[0].specular_f0.x, 0.02f, 1e-7f);
+  EXPECT_NEAR(s.materials[0].specular_f0.y, 0.01f, 1e-7f);
+  EXPECT_NEAR(s.materials[0].specular_f0.z, 0.04f, 1e-7f);
+  EXPECT_EQ(s.materials[0].specular_f90, 0.5f);
   g.extra =
       R"("extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"], )";
   g.material = R"({"pbrMetallicRoughness": {"baseColorFactor": [1, 0.9, 0.8, 1], "roughnessFactor": 0},

@@ -8,6 +8,7 @@
 
 #include "importers/gltf_loader.hpp"
 #include "io/image_io.hpp"
+#include "shade/material_bsdf.hpp"
 #include "shade/texture_lookup.hpp"
 #include "test_util.hpp"
 
@@ -173,6 +174,29 @@ TEST(TextureSlots, AnUnknownWrapModeIsAWarningAndRepeats) {
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("sampler wrapS of an unknown wrap mode: REPEAT used"), std::string::npos) << warnings[0];
   EXPECT_EQ(s.materials[0].diffuse_texture.sampler.wrap_s, Wrap::Repeat);
+}
+
+TEST(TextureSlots, MetallicRoughnessTextureScalesTheFactorsAsData) {
+  // Blue times metallicFactor, green times roughnessFactor, the bytes as data (no sRGB decoding:
+  // 128 is 0.502, not sRGB's 0.216).
+  std::vector<uint8_t> texels(12);
+  for (size_t i = 0; i < texels.size(); ++i) texels[i] = i % 3 == 0 ? 10 : i % 3 == 1 ? 128 : 64;
+  std::string json = textured_gltf("", "", true, Image8{4, 1, texels});
+  const std::string base = R"({"metallicFactor": 0, "baseColorTexture": {"index": 0)";
+  json.replace(json.find(base), base.size(),
+               R"({"metallicFactor": 0.5, "roughnessFactor": 0.8, "metallicRoughnessTexture": {"index": 0)");
+  const Scene s = load_gltf_from_memory(json, "t.gltf");
+  const Material& m = s.materials[0];
+  ASSERT_EQ(m.surface(), SurfaceKind::MetallicRoughness);
+  ASSERT_TRUE(m.metallic_roughness_texture.present());
+  EXPECT_FALSE(m.diffuse_texture.present());
+  Hit hit;
+  hit.tri = 0;
+  hit.u = hit.v = 0.3f;
+  const MaterialPoint p = material_point(s, hit, m);
+  EXPECT_NEAR(p.metallic, 0.5f * 64.0f / 255.0f, 1e-5f);
+  EXPECT_NEAR(p.roughness, 0.8f * 128.0f / 255.0f, 1e-5f);
+  EXPECT_EQ(p.color, Vec3{1.0f});  // no base colour texture: the factor's default
 }
 
 }  // namespace

@@ -42,9 +42,6 @@ Material Materials::map_material(const tg::Material& g, int index) {
   if (g.alphaMode != "OPAQUE" || (pbr.baseColorFactor.size() == 4 && pbr.baseColorFactor[3] < 1.0)) {
     warnings_.add("alpha (alphaMode " + g.alphaMode + ", base colour alpha) not rendered: surfaces are opaque");
   }
-  if (pbr.metallicRoughnessTexture.index >= 0) {
-    warnings_.add("metallicRoughnessTexture not used: its material's factors are");
-  }
   if (g.emissiveTexture.index >= 0) warnings_.add("emissiveTexture not used: the emissive factor is");
   const tg::Value* strength = extension(g.extensions, "KHR_materials_emissive_strength");
   const double emissive_strength = number(strength, "emissiveStrength", 1.0);
@@ -81,7 +78,6 @@ Material Materials::map_material(const tg::Material& g, int index) {
   const float f0_ior = ior >= 1.0f ? ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f)) : 0.04f;
   const Vec3 f0 = min(specular_colour * f0_ior, Vec3{1.0f}) * std::max(specular_factor, 0.0f);
   const std::string name = "material " + in_quotes(mat.name);
-  Vec3 diffuse_tint{1.0f};
   if (transmitted > 0.0f) {
     if (transmitted < 1.0f) warnings_.add("partial transmission rendered as full transmission (glass)");
     if (roughness > 0.0f) warnings_.add("rough transmission rendered smooth");
@@ -89,26 +85,27 @@ Material Materials::map_material(const tg::Material& g, int index) {
     mat.ni = ior > 0.0f ? ior : 1.5f;
     mat.tf = base;
     mat.kd = base;
-  } else if (metallic >= 1.0f && roughness == 0.0f) {
-    mat.illum = 3;
+  } else if (metallic >= 1.0f && roughness == 0.0f && pbr.metallicRoughnessTexture.index < 0 &&
+             pbr.baseColorTexture.index < 0) {
+    mat.illum = 3;  // a perfect mirror: the BRDF's limit, traced as the delta lobe it is
     mat.ks = base;
     mat.kd = Vec3{0.0f};
   } else {
-    mat.illum = 2;
-    mat.kd = base * (1.0f - metallic);
-    mat.ks = f0 * (1.0f - metallic) + base * metallic;
-    // GGX alpha = roughness^2 (glTF); tracer's glossy lobe reads it from a Phong exponent.
-    const float alpha = std::max(roughness * roughness, 1e-4f);
-    mat.ns = 2.0f / (alpha * alpha) - 2.0f;
-    diffuse_tint = Vec3{1.0f - metallic};
-    if (metallic > 0.0f && pbr.baseColorTexture.index >= 0) {
-      warnings_.add("a metallic base colour texture tints the specular by its factor only");
+    mat.metallic_roughness = true;
+    mat.kd = base;
+    mat.metallic = metallic;
+    mat.roughness = roughness;
+    mat.specular_f0 = f0;
+    mat.specular_f90 = std::clamp(specular_factor, 0.0f, 1.0f);
+    if (pbr.baseColorTexture.index >= 0) {
+      mat.diffuse_texture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                    pbr.baseColorTexture.extensions, false, base, name + " baseColorTexture");
     }
-  }
-  if (pbr.baseColorTexture.index >= 0 && mat.illum == 2) {
-    mat.diffuse_texture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                  pbr.baseColorTexture.extensions, false, base * diffuse_tint,
-                                  name + " baseColorTexture");
+    if (pbr.metallicRoughnessTexture.index >= 0) {
+      const tg::TextureInfo& t = pbr.metallicRoughnessTexture;
+      mat.metallic_roughness_texture =
+          texture(t.index, t.texCoord, t.extensions, true, Vec3{1.0f}, name + " metallicRoughnessTexture");
+    }
   }
   if (g.normalTexture.index >= 0) {
     mat.normal_texture = texture(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions, true,

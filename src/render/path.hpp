@@ -16,7 +16,6 @@
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
 #include "shade/material_bsdf.hpp"
-#include "shade/texture_lookup.hpp"
 
 namespace tracer {
 
@@ -44,6 +43,7 @@ inline std::array<float, 3> bsdf_numbers(const Bsdf& bsdf, const PathSampler& sa
     case Bsdf::Kind::Dielectric:
       return {sampler.get<1>(set)[0], 0.0f, 0.0f};
     case Bsdf::Kind::Smooth:
+    case Bsdf::Kind::MetallicRoughness:
       break;
   }
   if (!bsdf.two_lobes()) {
@@ -125,20 +125,19 @@ Vec3 path_radiance(const Accel& accel, const PassContext& ctx, Ray ray, const Pa
       radiance += beta * mat.ke * w;
     }
     if (depth >= s.max_depth) break;
-    const Vec3 kd = diffuse_color(scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
-    const Bsdf bsdf = material_bsdf(mat, kd, si.shading_n, si.front);
+    const MaterialPoint point = material_point(scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
+    const Bsdf bsdf = material_bsdf(mat, point, si.shading_n, si.front);
     const Vec3 wo = -ray.dir;
+    const Vec3 albedo = bsdf.delta() ? Vec3{1.0f} : point.albedo;
     if (!guided) {
       travelled += hit.t;
-      const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
-      guide->albedo = beta * Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
+      guide->albedo = beta * albedo;
       guide->normal = si.shading_n;
       guide->distance = travelled;
       guided = !bsdf.delta();
     }
     if (depth == 0 && first) {
-      const Vec3 a = bsdf.delta() ? Vec3{1.0f} : kd + mat.ks;
-      first->albedo = Vec3{std::min(a.x, 1.0f), std::min(a.y, 1.0f), std::min(a.z, 1.0f)};
+      first->albedo = albedo;
       first->normal = si.shading_n;
     }
     const std::array<float, 3> u_bsdf = bsdf_numbers(bsdf, sampler, bsdf_set(depth));

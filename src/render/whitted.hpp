@@ -4,8 +4,8 @@
 
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
+#include "shade/material_bsdf.hpp"
 #include "shade/optics.hpp"
-#include "shade/texture_lookup.hpp"
 
 namespace tracer {
 
@@ -56,9 +56,13 @@ Vec3 whitted_radiance(const Accel& accel, const PassContext& ctx, const Ray& ray
       return color;
     }
     case SurfaceKind::Diffuse:
+    case SurfaceKind::MetallicRoughness:
       break;
   }
-  const Vec3 kd = diffuse_color(*ctx.scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
+  // Whitted has no glossy lobe: MTL's Kd is diffuse, a metallic-roughness surface diffuse of its
+  // albedo (the metal's colour; the dielectric's base colour under its specular layer).
+  const MaterialPoint point = material_point(*ctx.scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));
+  const Vec3 kd = mat.metallic_roughness ? point.albedo : point.color;
   si.albedo_over_pi = kd * std::numbers::inv_pi_v<float>;
   return add_lamp_light(accel, ctx, si, emitted, counts) + kd * ctx.settings.ambient;
 }

@@ -36,12 +36,15 @@ struct Triangle {
   bool degenerate() const;
 };
 
-// How a material scatters light in the integrators that follow specular paths (whitted): the
-// study's ao workload shades every surface as diffuse.
-enum class SurfaceKind { Diffuse, Mirror, Dielectric };
+// How a material scatters light: MTL's diffuse-and-glossy, mirror and dielectric illumination
+// models, or glTF's metallic-roughness BRDF. The study's ao workload shades every surface as
+// diffuse.
+enum class SurfaceKind { Diffuse, Mirror, Dielectric, MetallicRoughness };
 
-// OBJ material: Kd diffuse, Ks specular, Ns specular exponent, Ke emission, Ni index of
-// refraction, Tf transmission filter, illum the MTL illumination model.
+// A surface's material. OBJ: Kd diffuse, Ks specular, Ns specular exponent, Ke emission, Ni index
+// of refraction, Tf transmission filter, illum the MTL illumination model. glTF's metallic-
+// roughness (metallic_roughness set): kd is the base colour, `metallic` and `roughness` the
+// factors, specular_f0 / specular_f90 the dielectric's Fresnel (docs/FORMATS.md has the mapping).
 struct Material {
   std::string name = "default";
   Vec3 kd{0.7f};
@@ -62,16 +65,27 @@ struct Material {
   // its x and y scaled by normal_scale.
   TextureSlot normal_texture;
   float normal_scale = 1.0f;
+  bool metallic_roughness = false;
+  float metallic = 0.0f, roughness = 1.0f;
+  Vec3 specular_f0{0.04f};
+  float specular_f90 = 1.0f;
+  // glTF's metallicRoughnessTexture: its blue channel scales `metallic`, its green `roughness`.
+  TextureSlot metallic_roughness_texture;
   // Every slot, for what treats them alike (the importers' index remapping and checks).
-  std::array<TextureSlot*, 3> slots() { return {&diffuse_texture, &bump_texture, &normal_texture}; }
-  std::array<const TextureSlot*, 3> slots() const { return {&diffuse_texture, &bump_texture, &normal_texture}; }
+  std::array<TextureSlot*, 4> slots() {
+    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture};
+  }
+  std::array<const TextureSlot*, 4> slots() const {
+    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture};
+  }
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced
-  // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse.
+  // refraction) are dielectrics of index Ni whose transmission Tf filters; the rest diffuse, or
+  // metallic-roughness.
   SurfaceKind surface() const {
     if (illum == 3 || illum == 5) return SurfaceKind::Mirror;
     if ((illum == 4 || illum == 6 || illum == 7 || illum == 9) && ni > 0.0f) return SurfaceKind::Dielectric;
-    return SurfaceKind::Diffuse;
+    return metallic_roughness ? SurfaceKind::MetallicRoughness : SurfaceKind::Diffuse;
   }
 };
 

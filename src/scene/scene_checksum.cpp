@@ -67,6 +67,13 @@ uint64_t scene_checksum(const Scene& scene) {
       slot(m.normal_texture);
       h.value(m.normal_scale);
     }
+    if (m.metallic_roughness) {  // glTF's; OBJ scenes keep the checksums they had
+      h.value(m.metallic);
+      h.value(m.roughness);
+      h.value(m.specular_f0);
+      h.value(m.specular_f90);
+      slot(m.metallic_roughness_texture);
+    }
   }
   h.value(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {

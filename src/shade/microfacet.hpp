@@ -1,6 +1,7 @@
-// The GGX (Trowbridge-Reitz) microfacet distribution with Smith's separable masking, in the local
-// frame where the macro-surface normal is +z (Walter et al. 2007, "Microfacet Models for
-// Refraction through Rough Surfaces").
+// The GGX (Trowbridge-Reitz) microfacet distribution with Smith's masking, separable (g1 * g1,
+// MTL's glossy lobe) or height-correlated (g2, glTF's BRDF), in the local frame where the
+// macro-surface normal is +z (Walter et al. 2007, "Microfacet Models for Refraction through Rough
+// Surfaces"; Heitz 2014, "Understanding the Masking-Shadowing Function").
 #pragma once
 
 #include <algorithm>
@@ -34,6 +35,18 @@ struct Ggx {
     const float c2 = v.z * v.z;
     const float tan2 = std::max(0.0f, 1.0f - c2) / c2;
     return 2.0f / (1.0f + std::sqrt(1.0f + alpha * alpha * tan2));
+  }
+  // Smith's Lambda of direction v (g1 = 1 / (1 + lambda)).
+  float lambda(Vec3 v) const {
+    const float c2 = v.z * v.z;
+    const float tan2 = std::max(0.0f, 1.0f - c2) / c2;
+    return 0.5f * (std::sqrt(1.0f + alpha * alpha * tan2) - 1.0f);
+  }
+  // Height-correlated masking-shadowing of the pair (wo, wi), both above the surface: what the
+  // glTF specification's appendix B prescribes.
+  float g2(Vec3 wo, Vec3 wi) const {
+    if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+    return 1.0f / (1.0f + lambda(wo) + lambda(wi));
   }
   // A normal drawn with density d(h) * h.z.
   Vec3 sample_normal(float u1, float u2) const {
