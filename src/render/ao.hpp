@@ -178,10 +178,9 @@ struct AoIntegrator {
       // The probe: the corner pixel of each 4x4 block (where lit) traces its AO rays by bundles.
       // Where a quarter or more of them escape (or no corner is lit), the chunk's other pixels do
       // too: escaping rays cross the tree, where a stream's packets of rays from scattered origins
-      // cost more than a bundle from one point (the Bunny: 1731 instructions a ray as a stream,
-      // 1199 so probed, bundles 1192). Else the rest go as one stream, which the occluder cache
-      // makes cheap where nearly every ray is blocked (Sponza: probing costs 22 of 762 a ray).
-      // docs/bench/LOG.md, session 31.
+      // cost more than a bundle from one point (the Bunny). Else the rest go as one stream, which
+      // the occluder cache makes cheap where nearly every ray is blocked (Sponza). The counts per
+      // ray, with their commands: docs/BENCHMARKS.md section 23 and docs/bench/LOG.md, session 31.
       const auto is_probe = [](int p) { return p % kPacketEdge == 0 && p / kChunkEdge % kPacketEdge == 0; };
       int probe_rays = 0, probe_open = 0;
       for (int p = 0; p < kChunkPixels; ++p) {

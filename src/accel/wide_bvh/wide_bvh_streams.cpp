@@ -59,7 +59,7 @@ HWY_INLINE uint32_t OccludedByTrianglePacket(const TrianglePack& p, int k, const
 // pushed in slot order (the last, the smallest subtree, searched first, as a single ray's any-hit
 // does), occluded lanes leaving every entry. `last_pack` is set to the last pack visited once a
 // lane of its entry is occluded, by it or earlier (for the occluder cache; keeping only packs that
-// occluded a lane themselves cost 0.6 % more instructions a ray in the Bunny, 0.2 % in Sponza).
+// occluded a lane themselves cost more instructions a ray: docs/bench/LOG.md, session 31).
 template <class Count>
 HWY_INLINE uint32_t OccludedPacketInTree(const WideBvh& bvh, const PacketState& st, uint32_t active, Count count,
                                          uint32_t& last_pack) {
