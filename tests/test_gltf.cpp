@@ -171,14 +171,15 @@ TEST(Gltf, MetallicRoughnessMapsAsDocumented) {
 
 TEST(Gltf, WhatCannotBeRenderedIsOneWarningEach) {
   TinyGltf g;
-  g.extra = R"("extensionsUsed": ["EXT_unknown_thing"], "animations": [], )";
-  g.material = R"({"alphaMode": "BLEND", "emissiveTexture": {"index": 0}})";
+  g.extra = R"("extensionsUsed": ["EXT_unknown_thing", "KHR_materials_transmission"], "animations": [], )";
+  g.material = R"({"alphaMode": "BLEND", "pbrMetallicRoughness": {"roughnessFactor": 0},
+                   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5}}})";
   std::vector<std::string> warnings;
   load_gltf_from_memory(g.json(), "t.gltf", [&](const std::string& w) { warnings.push_back(w); });
   ASSERT_EQ(warnings.size(), 3u);
   EXPECT_NE(warnings[0].find("t.gltf: extension 'EXT_unknown_thing' is not supported: ignored"), std::string::npos);
   EXPECT_NE(warnings[1].find("alpha"), std::string::npos);
-  EXPECT_NE(warnings[2].find("emissiveTexture not used"), std::string::npos);
+  EXPECT_NE(warnings[2].find("partial transmission rendered as full transmission"), std::string::npos);
 }
 
 TEST(Gltf, HostileFilesFailWithOneLineNamingTheFile) {

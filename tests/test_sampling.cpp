@@ -13,6 +13,7 @@
 #include "math/sampling.hpp"
 #include "math/sobol.hpp"
 #include "math/spherical_triangle.hpp"
+#include "scene/emission.hpp"
 #include "scene/emitters.hpp"
 #include "scene/environment_map.hpp"
 #include "scene/scene.hpp"
@@ -282,6 +283,84 @@ TEST(EmitterSampling, SolidAngleSamplesFollowTheirPdfWhichIntegratesToOne) {
   // The test can fail: area samples judged by the solid-angle density.
   double integral = 0.0;
   EXPECT_LT(emitter_chi_square(scene, by_area, by_angle, integral), 1e-5);
+}
+
+// The lamp of one_emitter() as a quad of two triangles beside each other, each of emission 2
+// times a texture: the first's black, the second's a 4 x 4 gradient over its corners (bilinear).
+Scene textured_lamp() {
+  Scene s;
+  Material lamp;
+  lamp.kd = Vec3{0.0f};
+  lamp.ke = Vec3{2.0f};
+  lamp.emission_texture.texture = 0;
+  s.materials = {lamp, lamp};
+  s.materials[0].emission_texture.texture = 1;
+  std::vector<uint8_t> rgb;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) rgb.insert(rgb.end(), {uint8_t(40 * x + 30 * y), uint8_t(200 - 40 * x), uint8_t(60)});
+  s.textures.push_back(Texture(4, 4, rgb));
+  s.textures.push_back(Texture(1, 1, {0, 0, 0}));
+  // Both wound so the front faces down, toward the origin.
+  s.add_mesh("black", {{-1.0f, 0.5f, -1.0f}, {0.0f, 0.5f, 1.0f}, {1.0f, 0.5f, -1.0f}}, {0, 2, 1}, 0);
+  s.add_mesh("lit", {{0.0f, 0.5f, 1.0f}, {1.0f, 0.5f, -1.0f}, {2.0f, 0.5f, 1.0f}}, {0, 1, 2}, 1);
+  s.corner_uvs = {{0.5f, 0.5f}, {0.5f, 0.5f}, {0.5f, 0.5f}, {0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}};
+  s.finalize();
+  return s;
+}
+
+TEST(EmitterSampling, TexturedEmissionIsSampledByItsPowerAndReadAtThePoint) {
+  const Scene scene = textured_lamp();
+  ASSERT_LT(scene.triangles[0].normal().y, 0.0f);
+  // The black triangle is no emitter and adds nothing to its light's power.
+  EXPECT_EQ(mean_emission(scene, 0), Vec3{0.0f});
+  ASSERT_EQ(scene.emitters.size(), 1u);
+  ASSERT_EQ(scene.lights.size(), 1u);
+  const float area = 0.5f * length(scene.triangles[1].normal());
+  const Vec3 mean = mean_emission(scene, 1);
+  EXPECT_NEAR(scene.lights[0].power.x, mean.x * area, 1e-5f * mean.x * area);
+  // The mean over the triangle against a fine numerical one (400 x 400 stratified points).
+  Vec3 fine{0.0f};
+  for (int i = 0; i < 400; ++i) {
+    for (int j = 0; j < 400; ++j) {
+      float b1, b2;
+      uniform_triangle((i + 0.5f) / 400.0f, (j + 0.5f) / 400.0f, b1, b2);
+      fine += emitted_radiance(scene, 1, b1, b2) * (1.0f / 160000.0f);
+    }
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], fine[c], 0.02f * fine[c]) << c;
+  // Irradiance at the origin (normal +y): the estimate of sampled points (radiance x cos / pdf)
+  // against the integral of the emission over the quad, by both samplings.
+  double reference = 0.0;
+  for (uint32_t t = 0; t < 2; ++t) {
+    const Triangle tri = scene.triangles[t];
+    const float a = 0.5f * length(tri.normal());
+    for (int i = 0; i < 400; ++i) {
+      for (int j = 0; j < 400; ++j) {
+        float b1, b2;
+        uniform_triangle((i + 0.5f) / 400.0f, (j + 0.5f) / 400.0f, b1, b2);
+        const Vec3 p = tri.v0 * (1.0f - b1 - b2) + tri.v1 * b1 + tri.v2 * b2;
+        const float d2 = dot(p, p), cos_r = p.y / std::sqrt(d2), cos_l = cos_r;  // the lamp is level
+        reference += double(emitted_radiance(scene, t, b1, b2).x) * cos_r * cos_l / d2 * a / 160000.0;
+      }
+    }
+  }
+  std::mt19937 gen(17);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const bool solid_angle : {true, false}) {
+    const Emitters e(scene, solid_angle);
+    const int n = 400000;
+    double sum = 0.0, sq = 0.0;
+    for (int i = 0; i < n; ++i) {
+      EmitterSample s;
+      if (!e.sample(scene, Vec3{0.0f}, u(gen), u(gen), u(gen), s)) continue;
+      ASSERT_GT(max_component(s.radiance), 0.0f);  // only the lit triangle is sampled
+      const double x = double(s.radiance.x) * s.wi.y / s.pdf;
+      sum += x;
+      sq += x * x;
+    }
+    const double mean_x = sum / n, sigma = std::sqrt(std::max(0.0, sq / n - mean_x * mean_x) / n);
+    EXPECT_NEAR(mean_x, reference, 4.0 * sigma + 1e-3 * reference) << solid_angle;
+  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "importers/gltf_loader.hpp"
 #include "io/image_io.hpp"
+#include "scene/emission.hpp"
 #include "shade/material_bsdf.hpp"
 #include "shade/texture_lookup.hpp"
 #include "test_util.hpp"
@@ -197,6 +198,31 @@ TEST(TextureSlots, MetallicRoughnessTextureScalesTheFactorsAsData) {
   EXPECT_NEAR(p.metallic, 0.5f * 64.0f / 255.0f, 1e-5f);
   EXPECT_NEAR(p.roughness, 0.8f * 128.0f / 255.0f, 1e-5f);
   EXPECT_EQ(p.color, Vec3{1.0f});  // no base colour texture: the factor's default
+}
+
+TEST(TextureSlots, EmissiveTextureTimesTheFactorIsWhatASurfaceEmits) {
+  std::vector<uint8_t> texels(12, 0);
+  texels[9] = texels[10] = texels[11] = 255;  // the last texel white, the rest black
+  std::string json = textured_gltf("", "", true, Image8{4, 1, texels});
+  const std::string base = R"("pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0}})";
+  const std::string emissive = R"("emissiveFactor": [1, 0.5, 0.25], "emissiveTexture": {"index": 0},
+      "pbrMetallicRoughness": {"metallicFactor": 0})";
+  json.replace(json.find(base), base.size(), emissive);
+  const Scene s = load_gltf_from_memory(json, "t.gltf");
+  ASSERT_TRUE(s.materials[0].emission_texture.present());
+  // Along the edge from corner 0 (u 0) to corner 1 (u 1): the white texel's centre is at u
+  // 0.875, the first black one's at 0.125.
+  EXPECT_EQ(emitted_radiance(s, 0, 0.125f, 0.0f), Vec3{0.0f});
+  const Vec3 lit = emitted_radiance(s, 0, 0.875f, 0.0f);
+  EXPECT_NEAR(lit.x, 1.0f, 1e-5f);
+  EXPECT_NEAR(lit.y, 0.5f, 1e-5f);
+  EXPECT_NEAR(lit.z, 0.25f, 1e-5f);
+  // A factor of 0 (glTF's default) emits nothing, whatever the texture: it is not read.
+  const std::string factor = R"("emissiveFactor": [1, 0.5, 0.25])";
+  json.replace(json.find(factor), factor.size(), R"("emissiveFactor": [0, 0, 0])");
+  const Scene dark = load_gltf_from_memory(json, "t.gltf");
+  EXPECT_FALSE(dark.materials[0].emission_texture.present());
+  EXPECT_TRUE(dark.emitters.empty());
 }
 
 }  // namespace

@@ -42,7 +42,6 @@ Material Materials::map_material(const tg::Material& g, int index) {
   if (g.alphaMode != "OPAQUE" || (pbr.baseColorFactor.size() == 4 && pbr.baseColorFactor[3] < 1.0)) {
     warnings_.add("alpha (alphaMode " + g.alphaMode + ", base colour alpha) not rendered: surfaces are opaque");
   }
-  if (g.emissiveTexture.index >= 0) warnings_.add("emissiveTexture not used: the emissive factor is");
   const tg::Value* strength = extension(g.extensions, "KHR_materials_emissive_strength");
   const double emissive_strength = number(strength, "emissiveStrength", 1.0);
   if (g.emissiveFactor.size() >= 3) {
@@ -106,6 +105,12 @@ Material Materials::map_material(const tg::Material& g, int index) {
       mat.metallic_roughness_texture =
           texture(t.index, t.texCoord, t.extensions, true, Vec3{1.0f}, name + " metallicRoughnessTexture");
     }
+  }
+  // The emissive texture times the factor (and strength); with a factor of 0 (the default) it
+  // lights nothing and is not read.
+  if (g.emissiveTexture.index >= 0 && mat.emissive()) {
+    mat.emission_texture = texture(g.emissiveTexture.index, g.emissiveTexture.texCoord, g.emissiveTexture.extensions,
+                                   false, Vec3{1.0f}, name + " emissiveTexture");
   }
   if (g.normalTexture.index >= 0) {
     mat.normal_texture = texture(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions, true,

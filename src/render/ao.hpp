@@ -14,6 +14,7 @@
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
 #include "render/stream_order.hpp"
+#include "scene/emission.hpp"
 
 namespace tracer {
 
@@ -91,7 +92,7 @@ Vec3 shade_hit(const Accel& accel, const PassContext& ctx, int x, int y, const R
                RayCounts& counts, uint32_t sample = 0) {
   if (!hit.valid()) return Vec3{0.0f};
   const SurfaceInteraction si = surface_interaction(ctx, primary, hit);
-  const Vec3 direct = add_lamp_light(accel, ctx, si, si.mat->ke, counts);
+  const Vec3 direct = add_lamp_light(accel, ctx, si, emitted_radiance(*ctx.scene, hit.tri, hit.u, hit.v), counts);
   return finish_with_ambient(accel, ctx, x, y, si, direct, counts, sample);
 }
 
@@ -124,7 +125,7 @@ struct AoIntegrator {
       radiance[k] = Vec3{0.0f};
       if (!hits[k].valid()) continue;
       sis[k] = surface_interaction(ctx, block.rays[k], hits[k]);
-      radiance[k] = sis[k].mat->ke;
+      radiance[k] = emitted_radiance(*ctx.scene, hits[k].tri, hits[k].u, hits[k].v);
       lit |= 1u << k;
     }
     add_lamp_light(accel, ctx, sis, lit, radiance, counts);

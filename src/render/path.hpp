@@ -15,6 +15,7 @@
 #include "math/sobol.hpp"
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
+#include "scene/emission.hpp"
 #include "shade/material_bsdf.hpp"
 
 namespace tracer {
@@ -122,7 +123,7 @@ Vec3 path_radiance(const Accel& accel, const PassContext& ctx, Ray ray, const Pa
       if (nee && !unsampled) {
         w = power_heuristic(bsdf_pdf, lights.pdf_emitter(hit.tri, hit.inst, ray.org, si.position));
       }
-      radiance += beta * mat.ke * w;
+      radiance += beta * emitted_radiance(scene, hit.tri, hit.u, hit.v) * w;
     }
     if (depth >= s.max_depth) break;
     const MaterialPoint point = material_point(scene, hit, mat, cone, std::fabs(dot(ray.dir, si.n)));

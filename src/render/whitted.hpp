@@ -4,6 +4,7 @@
 
 #include "render/direct_light.hpp"
 #include "render/pixel_samples.hpp"
+#include "scene/emission.hpp"
 #include "shade/material_bsdf.hpp"
 #include "shade/optics.hpp"
 
@@ -21,7 +22,7 @@ Vec3 whitted_radiance(const Accel& accel, const PassContext& ctx, const Ray& ray
   Hit hit;
   if (!accel.intersect(ray, hit)) return EnvironmentLight::of(ctx).radiance(ray.dir);
   SurfaceInteraction si = surface_interaction(ctx, ray, hit);  // si.n faces the ray's side
-  const Vec3 emitted = si.mat->ke;
+  const Vec3 emitted = emitted_radiance(*ctx.scene, hit.tri, hit.u, hit.v);
   si.shading_n = interpolated_normal(*ctx.scene, hit, si.n);
   const Material& mat = *si.mat;
   si.shading_n = bumped_normal(*ctx.scene, hit, mat, si.shading_n, -ray.dir);

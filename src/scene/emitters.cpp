@@ -5,6 +5,7 @@
 
 #include "math/sampling.hpp"
 #include "math/spherical_triangle.hpp"
+#include "scene/emission.hpp"
 #include "scene/scene.hpp"
 
 namespace tracer {
@@ -17,7 +18,7 @@ Emitters::Emitters(const Scene& scene, bool solid_angle) : solid_angle_(solid_an
       const Material& m = scene.materials[scene.tri_material[i]];
       if (!m.emissive() || scene.triangles[i].degenerate()) continue;
       const float area = 0.5f * length(scene.world_triangle(i, inst).normal());
-      const double p = double(luminance(m.ke)) * double(area);
+      const double p = double(luminance(mean_emission(scene, i))) * double(area);  // 0 over black texels
       if (!(area > 0.0f) || !(p > 0.0) || !std::isfinite(p)) continue;
       keys_.push_back(key(i, inst));
       area_.push_back(area);
@@ -70,7 +71,13 @@ bool Emitters::sample(const Scene& scene, Vec3 from, float u_select, float u1, f
     out.distance = along;
     out.point = from + w * along;
     out.pdf = float(double(pmf_[i]) / omega);
-    out.radiance = scene.materials[scene.tri_material[tri]].ke;
+    // The point's barycentric coordinates, for its texel: the triangle's areas opposite each corner.
+    const Vec3 e1 = t.v1 - t.v0, e2 = t.v2 - t.v0, d = out.point - t.v0;
+    const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), dp1 = dot(d, e1), dp2 = dot(d, e2);
+    const float det = d11 * d22 - d12 * d12;
+    const float b1 = det != 0.0f ? std::clamp((d22 * dp1 - d12 * dp2) / det, 0.0f, 1.0f) : 0.0f;
+    const float b2 = det != 0.0f ? std::clamp((d11 * dp2 - d12 * dp1) / det, 0.0f, 1.0f - b1) : 0.0f;
+    out.radiance = emitted_radiance(scene, tri, b1, b2);
     return std::isfinite(out.pdf);
   }
   float b1, b2;
@@ -84,7 +91,7 @@ bool Emitters::sample(const Scene& scene, Vec3 from, float u_select, float u1, f
   const float cos_light = -dot(normalize(scene.face_normal(t, inst)), out.wi);  // the front face must face `from`
   if (!(cos_light > 0.0f)) return false;
   out.pdf = pmf_[i] * d2 / (area_[i] * cos_light);
-  out.radiance = scene.materials[scene.tri_material[tri]].ke;
+  out.radiance = emitted_radiance(scene, tri, b1, b2);
   return std::isfinite(out.pdf);
 }
 

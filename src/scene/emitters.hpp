@@ -1,5 +1,6 @@
 // The emissive triangles as area lights for the path integrator: each with its true area and
-// normal, chosen in proportion to its power (luminance of Ke times area), then a direction toward
+// normal, chosen in proportion to its power (luminance of its mean emission, textured or not,
+// times area: a triangle over black texels is none of them), then a direction toward
 // it uniformly in the solid angle it subtends where that angle is large (math/spherical_triangle.hpp),
 // else a point on it uniformly by area. Emission is one-sided, from the face the winding makes the front
 // (counter-clockwise seen from the lit side), as in pbrt and the measured Cornell box: a lamp mounted just below a
@@ -20,7 +21,7 @@ struct EmitterSample {
   Vec3 point;  // on the emitter
   Vec3 wi;     // unit direction from the shading point to `point`
   float distance;
-  Vec3 radiance;  // Ke of the emitter
+  Vec3 radiance;  // what the emitter emits at `point` (scene/emission.hpp)
   float pdf;      // solid-angle density at the shading point (selection times area density)
 };
 

@@ -6,6 +6,8 @@
 #include <utility>
 
 #include "base/errors.hpp"
+#include "math/sampling.hpp"
+#include "scene/emission.hpp"
 
 namespace tracer {
 
@@ -93,10 +95,14 @@ void Scene::finalize() {
   // One area light per (geometry, emissive material) and instance: the Cornell lamp is one quad,
   // one light.
   std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
+  // A light's power is its emission times its area; with an emission texture, the sum of its
+  // triangles' mean emission times area, and its position their centroids weighted by that.
   struct Accum {
-    Vec3 weighted_centroid, normal;
+    Vec3 weighted_centroid, normal, ke;
     float area = 0;
-    Vec3 ke;
+    bool textured = false;
+    Vec3 power, power_centroid;
+    float luminance = 0;
   };
   const auto add_lights = [&](TriangleRange range, uint32_t inst) {
     std::map<std::pair<uint32_t, uint32_t>, Accum> by_source;
@@ -111,14 +117,21 @@ void Scene::finalize() {
       a.normal += n * 0.5f;
       a.area += area;
       a.ke = m.ke;
+      if (m.emission_texture.present()) {
+        const Vec3 power = mean_emission(*this, uint32_t(i)) * area;
+        a.textured = true;
+        a.power += power;
+        a.power_centroid += t.centroid() * luminance(power);
+        a.luminance += luminance(power);
+      }
     }
     for (const auto& [key, a] : by_source) {
-      if (a.area <= 0.0f) continue;
+      if (a.area <= 0.0f || (a.textured && !(a.luminance > 0.0f))) continue;  // no area, or black texels only
       Light l;
-      l.position = a.weighted_centroid / a.area;
+      l.position = a.textured ? a.power_centroid / a.luminance : a.weighted_centroid / a.area;
       const float n_len = length(a.normal);
       l.normal = n_len > 0.0f ? a.normal / n_len : Vec3{0.0f, -1.0f, 0.0f};
-      l.power = a.ke * a.area;
+      l.power = a.textured ? a.power : a.ke * a.area;
       l.area = a.area;
       l.geomID = key.first;
       l.inst = inst;

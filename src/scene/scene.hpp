@@ -71,12 +71,14 @@ struct Material {
   float specular_f90 = 1.0f;
   // glTF's metallicRoughnessTexture: its blue channel scales `metallic`, its green `roughness`.
   TextureSlot metallic_roughness_texture;
+  // glTF's emissiveTexture: the emission `ke` times its texel (scene/emission.hpp).
+  TextureSlot emission_texture;
   // Every slot, for what treats them alike (the importers' index remapping and checks).
-  std::array<TextureSlot*, 4> slots() {
-    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture};
+  std::array<TextureSlot*, 5> slots() {
+    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture, &emission_texture};
   }
-  std::array<const TextureSlot*, 4> slots() const {
-    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture};
+  std::array<const TextureSlot*, 5> slots() const {
+    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture, &emission_texture};
   }
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced

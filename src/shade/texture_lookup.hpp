@@ -1,4 +1,4 @@
-// What the textures say at a hit: each slot's coordinates (its set, its transform), the diffuse
+// What the textures say at a hit: each slot's coordinates (scene/slot_coordinates.hpp), the diffuse
 // colour filtered to the ray's footprint (ray cones and the texture level of detail) and the
 // shading normal moved by the bump map.
 #pragma once
@@ -8,25 +8,12 @@
 
 #include "math/ray.hpp"
 #include "scene/scene.hpp"
+#include "scene/slot_coordinates.hpp"
 
 namespace tracer {
 
 // The texture coordinates at a hit, interpolated from its triangle's corners `c`.
-inline Vec2 hit_uv(const Vec2* c, const Hit& hit) {
-  const float w = 1.0f - hit.u - hit.v;
-  return {c[0].x * w + c[1].x * hit.u + c[2].x * hit.v, c[0].y * w + c[1].y * hit.u + c[2].y * hit.v};
-}
-
-// The corners' coordinates that `slot` reads on scene triangle `tri`: its set's, moved by its
-// transform. False where the slot is empty or the scene has no such set.
-inline bool slot_corners(const Scene& scene, uint32_t tri, const TextureSlot& slot, Vec2 out[3]) {
-  if (!slot.present()) return false;
-  const LargeVector<Vec2>& set = slot.uv_set == 1 ? scene.corner_uvs1 : scene.corner_uvs;
-  if (set.empty()) return false;
-  const Vec2* c = &set[3 * size_t(tri)];
-  for (int k = 0; k < 3; ++k) out[k] = slot.transform.identity() ? c[k] : slot.transform.apply(c[k]);
-  return true;
-}
+inline Vec2 hit_uv(const Vec2* c, const Hit& hit) { return interpolate_uv(c, hit.u, hit.v); }
 
 // The shading normal `ns` moved by the material's normal map or bump map. A normal map (glTF's
 // normalTexture) gives the normal in the frame of the tangent dp/du made perpendicular to ns,
