@@ -17,6 +17,7 @@
 #include "importers/scene_file.hpp"
 #include "io/image_io.hpp"
 #include "scene_writers.hpp"
+#include "shade/material_bsdf.hpp"
 #include "shade/texture_lookup.hpp"
 #include "test_util.hpp"
 
@@ -76,6 +77,40 @@ TEST(Gltf, OneTriangleLoadsWithItsMaterial) {
   EXPECT_EQ(m.roughness, 1.0f);
   EXPECT_NEAR(m.specular_f0.x, 0.04f, 1e-7f);
   EXPECT_EQ(m.specular_f90, 1.0f);
+}
+
+// TinyGltf's triangle with a COLOR_0 of normalised unsigned bytes (VEC4) after its indices, the
+// accessor's members besides those given by `members`.
+std::string coloured_gltf(const std::string& members = R"("normalized": true)") {
+  TinyGltf g;
+  g.indices += bytes_of<uint8_t>({255, 51, 0, 255, 255, 51, 0, 128, 0, 0, 255, 7});
+  std::string json = g.json();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    json.replace(json.find(from), from.size(), to);
+  };
+  replace(R"("attributes": {"POSITION": 0})", R"("attributes": {"POSITION": 0, "COLOR_0": 2})");
+  replace(R"({"buffer": 0, "byteOffset": 36, "byteLength": 8}])",
+          R"({"buffer": 0, "byteOffset": 36, "byteLength": 8}, {"buffer": 0, "byteOffset": 44, "byteLength": 12}])");
+  replace(
+      R"("type": "SCALAR"}]})",
+      R"("type": "SCALAR"}, {"bufferView": 2, "componentType": 5121, "count": 3, "type": "VEC4", )" + members + "}]}");
+  return json;
+}
+
+TEST(Gltf, VertexColoursMultiplyTheBaseColour) {
+  const Scene s = load_gltf_from_memory(coloured_gltf(), "t.gltf");
+  ASSERT_EQ(s.corner_colors.size(), 3u);
+  EXPECT_EQ(s.corner_colors[0], (Vec3{1.0f, 0.2f, 0.0f}));  // linear, as glTF stores them; alpha unread
+  Hit hit;
+  hit.tri = 0;
+  const MaterialPoint p = material_point(s, hit, s.materials[0]);  // at corner 0
+  EXPECT_NEAR(p.color.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(p.color.y, 0.25f * 0.2f, 1e-6f);
+  EXPECT_EQ(p.color.z, 0.0f);
+  // Integers must be normalised (the specification's COLOR_0 types).
+  EXPECT_EQ(gltf_load_error(coloured_gltf(R"("normalized": false)")),
+            "t.gltf: mesh 0 'tri' primitive 0 COLOR_0 (accessor 2): not VEC3 or VEC4 of floats or normalised "
+            "unsigned bytes or shorts");
 }
 
 TEST(Gltf, NodeTransformsComposeAndAMirrorKeepsTheFrontFace) {
@@ -785,8 +820,33 @@ TEST(Ply, PolygonsOfAnyIndexTypeAreTriangulated) {
   EXPECT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].kd, Material{}.kd);
   ASSERT_EQ(warnings.size(), 2u);
-  EXPECT_EQ(warnings[0], "t.ply: vertex colours not used");
+  EXPECT_EQ(warnings[0], "t.ply: vertex colours without all of red, green and blue not used");
   EXPECT_EQ(warnings[1], "t.ply: element 'edge' ignored");
+}
+
+// Integer channels are sRGB codes, float ones linear; they multiply the diffuse colour at a hit.
+TEST(Ply, VertexColoursMultiplyTheDiffuseColour) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const Scene s = load_ply_from_memory(header + "0 0 0 255 128 0\n1 0 0 255 128 0\n0 1 0 0 0 0\n3 0 1 2\n", "t.ply");
+  ASSERT_EQ(s.corner_colors.size(), 3u);
+  EXPECT_EQ(s.corner_colors[0].x, 1.0f);
+  EXPECT_NEAR(s.corner_colors[0].y, 0.21586f, 1e-4f);  // sRGB 128
+  Hit hit;
+  hit.tri = 0;
+  hit.u = 0.5f, hit.v = 0.0f;  // halfway between the first two corners: their colour
+  const Vec3 c = diffuse_color(s, hit, s.materials[0]);
+  EXPECT_NEAR(c.x, Material{}.kd.x, 1e-6f);
+  EXPECT_NEAR(c.y, Material{}.kd.y * 0.21586f, 1e-4f);
+  EXPECT_EQ(c.z, 0.0f);
+  const std::string floats =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float r\nproperty float g\nproperty float b\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0 0.5 0.5 0.5\n1 0 0 0.5 0.5 0.5\n"
+      "0 1 0 0.5 0.5 0.5\n3 0 1 2\n";
+  EXPECT_EQ(load_ply_from_memory(floats, "f.ply").corner_colors[2], Vec3{0.5f});  // linear as given
 }
 
 // Faces whose triangles would not fit the memory limit are refused at the header, before they are

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "math/srgb.hpp"
+
 namespace tracer {
 
 namespace {
@@ -16,7 +18,7 @@ uint8_t encode(float linear, float exposure) {
 float display_value(float linear, float exposure) {
   if (!(linear > 0.0f)) return 0.0f;  // also maps NaN to black
   const float mapped = 1.0f - std::exp(-exposure * linear);
-  return mapped <= 0.0031308f ? 12.92f * mapped : 1.055f * std::pow(mapped, 1.0f / 2.4f) - 0.055f;
+  return linear_to_srgb(mapped);
 }
 
 Image8 tonemap(const Framebuffer& fb, float exposure) {

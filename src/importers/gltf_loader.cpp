@@ -100,6 +100,7 @@ class GltfScene {
     if (any_attribute("NORMAL")) scene_.corner_normals.reserve(3 * total);
     if (any_attribute("TEXCOORD_0")) scene_.corner_uvs.reserve(3 * total);
     if (any_attribute("TEXCOORD_1")) scene_.corner_uvs1.reserve(3 * total);
+    if (any_attribute("COLOR_0")) scene_.corner_colors.reserve(3 * total);
     scene_.geometries.reserve(primitives);
     if (instanced_) scene_.instances.reserve(instances);
     // Each node's own transform once: a shared node is walked once per path that reaches it.
@@ -136,7 +137,8 @@ class GltfScene {
     f.instances = f.instanced ? all.instances : 0;
     const int uv_sets = int(any_attribute("TEXCOORD_0")) + int(any_attribute("TEXCOORD_1"));
     const uint64_t per_triangle =
-        Scene::bytes_per_triangle(any_attribute("NORMAL"), uv_sets) + limits_.accel_bytes_per_triangle;
+        Scene::bytes_per_triangle(any_attribute("NORMAL"), uv_sets, any_attribute("COLOR_0")) +
+        limits_.accel_bytes_per_triangle;
     constexpr uint64_t kPerPrimitive = sizeof(Geometry) + 32;  // and its name
     f.bytes = f.triangles >= kSaturated / per_triangle || f.primitives >= kSaturated / kPerPrimitive ||
                       f.instances >= kSaturated / kBytesPerInstance
@@ -532,8 +534,7 @@ class GltfScene {
   }
 
   void add_light(const tg::Value& ext, const Affine& world) {
-    if (std::optional<Light> l = gltf::point_light_of(model_, name_, warnings_, ext, world))
-      scene_.lights.push_back(*l);
+    if (std::optional<Light> l = gltf::point_light_of(model_, name_, warnings_, ext, world)) scene_.lights.push_back(*l);
   }
 
   const tg::Model& model_;

@@ -62,7 +62,25 @@ std::optional<IndexedMesh> primitive_mesh(const tg::Model& model_, const std::st
       (*out)[i] = std::isfinite(u) && std::isfinite(v) ? Vec2{u, 1.0f - v} : Vec2{};
     }
   }
-  if (p.attributes.count("COLOR_0")) warnings_.add("vertex colours (COLOR_0) not used");
+  if (const auto c = p.attributes.find("COLOR_0"); c != p.attributes.end()) {
+    // Linear RGB or RGBA, float or normalised unsigned bytes or shorts (the specification's
+    // types); alpha is not read (surfaces are opaque).
+    const std::string at = where(what + " COLOR_0");
+    const gltf::Elements colors = gltf::elements(model_, c->second, at);
+    const bool integer = colors.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                         colors.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    if ((colors.components != 3 && colors.components != 4) ||
+        (colors.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT && !(integer && colors.normalized))) {
+      throw InputError(at + " (accessor " + std::to_string(c->second) +
+                       "): not VEC3 or VEC4 of floats or normalised unsigned bytes or shorts");
+    }
+    if (colors.count != positions.count) throw error(what + ": COLOR_0 and POSITION counts differ");
+    mesh.colors.resize(colors.count);
+    for (size_t i = 0; i < colors.count; ++i) {
+      const Vec3 v{colors.get(i, 0), colors.get(i, 1), colors.get(i, 2)};
+      mesh.colors[i] = is_finite(v) ? min(max(v, Vec3{0.0f}), Vec3{1.0f}) : Vec3{1.0f};
+    }
+  }
   std::vector<uint32_t> list;
   if (p.indices >= 0) {
     const gltf::Elements ix = gltf::elements(model_, p.indices, where(what + " indices"));

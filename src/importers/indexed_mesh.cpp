@@ -47,6 +47,12 @@ void append_mesh(Scene& scene, const std::string& name, const IndexedMesh& mesh,
   };
   place_uvs(mesh.uvs, scene.corner_uvs);
   place_uvs(mesh.uvs1, scene.corner_uvs1);
+  if (!mesh.colors.empty() || !scene.corner_colors.empty()) {  // white where a mesh has none
+    scene.corner_colors.resize(3 * (first + count), Vec3{1.0f});
+    for (size_t t = 0; t < count && !mesh.colors.empty(); ++t)
+      for (int k = 0; k < 3; ++k)
+        scene.corner_colors[3 * (first + t) + k] = mesh.colors[mesh.indices[3 * t + corner[k]]];
+  }
   scene.vertex_count += mesh.positions.size();
   scene.geometries.push_back({name, uint32_t(first), uint32_t(count)});
 }

@@ -17,6 +17,7 @@ struct IndexedMesh {
   std::vector<Vec3> normals;      // empty, or one per position
   std::vector<Vec2> uvs;          // empty, or one per position; v = 0 is the image's bottom row (OBJ's)
   std::vector<Vec2> uvs1;         // the second set (glTF's TEXCOORD_1), likewise
+  std::vector<Vec3> colors;       // empty, or one per position: linear RGB (glTF's COLOR_0, PLY's)
   std::vector<uint32_t> indices;  // three per triangle, each below positions.size()
   size_t triangle_count() const { return indices.size() / 3; }
 };

@@ -50,8 +50,8 @@ struct LoadLimits {
 // count a file's triangles before assembling the scene (OBJ after its parse, PLY from its header),
 // so a scene that will not fit is refused before its arrays are allocated.
 inline void refuse_past_memory(const LoadLimits& limits, const std::string& name, uint64_t triangles, bool normals,
-                               bool uvs) {
-  const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs) + limits.accel_bytes_per_triangle;
+                               bool uvs, bool colors = false) {
+  const uint64_t per_triangle = Scene::bytes_per_triangle(normals, uvs, colors) + limits.accel_bytes_per_triangle;
   const uint64_t bytes = triangles > UINT64_MAX / per_triangle ? UINT64_MAX : triangles * per_triangle;
   if (bytes <= limits.max_memory) return;
   throw InputError(memory_refusal(name + ": its " + std::to_string(triangles) + " triangles" +

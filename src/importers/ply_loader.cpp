@@ -2,6 +2,7 @@
 
 #include <fast_float/fast_float.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <charconv>
@@ -13,6 +14,7 @@
 #include "base/stopwatch.hpp"
 #include "base/text.hpp"
 #include "importers/indexed_mesh.hpp"
+#include "math/srgb.hpp"
 #include "math/triangulate.hpp"
 
 namespace tracer {
@@ -304,6 +306,8 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;
     int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1, u = -1, v = -1, list = -1;
+    int rgb[3] = {-1, -1, -1};
+    float rgb_scale[3] = {1.0f, 1.0f, 1.0f};  // an integer channel's largest value, 1 for floats
     if (is_vertex) {
       x = e.find("x"), y = e.find("y"), z = e.find("z");
       if (x < 0 || y < 0 || z < 0) throw InputError(name + ":" + std::to_string(e.line) + ": vertex has no x, y and z");
@@ -315,11 +319,25 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
           break;
         }
       }
-      if (e.find("red") >= 0 || e.find("r") >= 0) warnings.add("vertex colours not used");
+      // Vertex colours: integer channels as sRGB codes (as Blender's importer reads them), float
+      // channels as linear values in [0, 1].
+      for (const auto& names : {std::array<const char*, 3>{"red", "green", "blue"}, {"r", "g", "b"}}) {
+        if (e.find(names[0]) < 0 || e.find(names[1]) < 0 || e.find(names[2]) < 0) continue;
+        for (int c = 0; c < 3; ++c) {
+          rgb[c] = e.find(names[size_t(c)]);
+          const PlyType t = e.properties[size_t(rgb[c])].type;
+          rgb_scale[c] = t == PlyType::Uint8 || t == PlyType::Int8 ? 255.0f : is_integer(t) ? 65535.0f : 1.0f;
+        }
+        break;
+      }
+      if (rgb[0] < 0 && (e.find("red") >= 0 || e.find("r") >= 0 || e.find("green") >= 0 || e.find("g") >= 0)) {
+        warnings.add("vertex colours without all of red, green and blue not used");
+      }
       if (e.count > UINT32_MAX) throw InputError(name + ": more than 2^32 vertices");
       mesh.positions.reserve(e.count);
       if (nx >= 0) mesh.normals.reserve(e.count);
       if (u >= 0) mesh.uvs.reserve(e.count);
+      if (rgb[0] >= 0) mesh.colors.reserve(e.count);
       have_vertices = true;
     } else if (is_face) {
       if (!have_vertices) throw InputError(name + ":" + std::to_string(e.line) + ": faces before the vertices");
@@ -329,7 +347,8 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
         throw InputError(name + ":" + std::to_string(e.line) + ": face has no integer list vertex_indices");
       }
       // At least a triangle a face: refused here, before the triangles are read.
-      refuse_past_memory(limits, name, e.count, mesh.normals.capacity() > 0, mesh.uvs.capacity() > 0);
+      refuse_past_memory(limits, name, e.count, mesh.normals.capacity() > 0, mesh.uvs.capacity() > 0,
+                         mesh.colors.capacity() > 0);
       have_faces = true;
     } else {
       warnings.add("element " + in_quotes(e.name) + " ignored");
@@ -375,6 +394,14 @@ Scene load(std::string_view bytes, const std::string& name, const WarningSink& w
         if (u >= 0) {
           const Vec2 t{float(row[size_t(u)]), float(row[size_t(v)])};
           mesh.uvs.push_back(std::isfinite(t.x) && std::isfinite(t.y) ? t : Vec2{});
+        }
+        if (rgb[0] >= 0) {
+          Vec3 c;
+          for (int k = 0; k < 3; ++k) {
+            const float value = std::clamp(float(row[size_t(rgb[k])]) / rgb_scale[k], 0.0f, 1.0f);
+            c[k] = rgb_scale[k] > 1.0f ? srgb_to_linear(value) : value;
+          }
+          mesh.colors.push_back(is_finite(c) ? c : Vec3{1.0f});
         }
       } else if (is_face) {
         if (polygon.size() < 3) {

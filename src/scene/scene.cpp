@@ -36,6 +36,7 @@ void Scene::add_mesh(const std::string& name, const std::vector<Vec3>& vertices,
   if (!corner_normals.empty()) corner_normals.resize(3 * triangles.size(), Vec3{0.0f});  // none for this mesh
   if (!corner_uvs.empty()) corner_uvs.resize(3 * triangles.size(), Vec2{});
   if (!corner_uvs1.empty()) corner_uvs1.resize(3 * triangles.size(), Vec2{});
+  if (!corner_colors.empty()) corner_colors.resize(3 * triangles.size(), Vec3{1.0f});
   geometries.push_back(std::move(g));
 }
 
@@ -157,8 +158,8 @@ uint64_t Scene::memory_bytes() const {
                    (tri_geom.capacity() + tri_prim.capacity() + tri_material.capacity()) * sizeof(uint32_t) +
                    corner_normals.capacity() * sizeof(Vec3) +
                    (corner_uvs.capacity() + corner_uvs1.capacity()) * sizeof(Vec2) +
-                   geometries.capacity() * sizeof(Geometry) + emitters.memory_bytes() +
-                   meshes.capacity() * sizeof(Mesh) + instances.capacity() * sizeof(Instance);
+                   corner_colors.capacity() * sizeof(Vec3) + geometries.capacity() * sizeof(Geometry) +
+                   emitters.memory_bytes() + meshes.capacity() * sizeof(Mesh) + instances.capacity() * sizeof(Instance);
   for (const Texture& t : textures) bytes += t.srgb().size() * 4 / 3;  // and its mip levels
   return bytes;
 }

@@ -133,6 +133,9 @@ struct Scene {
   // when it has none; corner_uvs1 the second set (TEXCOORD_1), read by slots whose uv_set is 1.
   LargeVector<Vec2> corner_uvs;
   LargeVector<Vec2> corner_uvs1;
+  // Vertex colours (glTF's COLOR_0, PLY's red/green/blue), linear, three per triangle, or empty
+  // when no mesh has them (white where one lacks them): they multiply the diffuse or base colour.
+  LargeVector<Vec3> corner_colors;
   std::vector<Texture> textures;
   std::vector<Geometry> geometries;
   std::vector<Material> materials;
@@ -179,10 +182,10 @@ struct Scene {
   // The bytes its arrays and textures hold (an estimate of what it occupies).
   uint64_t memory_bytes() const;
   // Per triangle: its corners, ids and material, and its corners' normals and texture coordinates
-  // (of `uv_sets` sets) where the scene has them.
-  static constexpr uint64_t bytes_per_triangle(bool normals, int uv_sets) {
+  // (of `uv_sets` sets) and colours where the scene has them.
+  static constexpr uint64_t bytes_per_triangle(bool normals, int uv_sets, bool colors = false) {
     return sizeof(Triangle) + 3 * sizeof(uint32_t) + (normals ? 3 * sizeof(Vec3) : 0) +
-           uint64_t(uv_sets) * 3 * sizeof(Vec2);
+           uint64_t(uv_sets) * 3 * sizeof(Vec2) + (colors ? 3 * sizeof(Vec3) : 0);
   }
   // Recomputes bounds, degenerate count, the area lights and the emitters from emissive materials
   // (each instance of an emissive mesh its own lights).

@@ -42,6 +42,7 @@ uint64_t scene_checksum(const Scene& scene) {
   h.array(scene.corner_normals);
   h.array(scene.corner_uvs);
   if (!scene.corner_uvs1.empty()) h.array(scene.corner_uvs1);  // scenes without keep their checksums
+  if (!scene.corner_colors.empty()) h.array(scene.corner_colors);
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     for (const Vec3& c : {m.kd, m.ks, m.ke, m.tf}) h.value(c);

@@ -11,6 +11,7 @@
 
 #include "base/errors.hpp"
 #include "base/read_input.hpp"
+#include "math/srgb.hpp"
 
 namespace tracer {
 
@@ -24,7 +25,7 @@ const std::array<float, 256> kSrgbToLinear = [] {
   std::array<float, 256> t{};
   for (int i = 0; i < 256; ++i) {
     const float c = float(i) / 255.0f;
-    t[size_t(i)] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+    t[size_t(i)] = srgb_to_linear(c);
   }
   return t;
 }();
@@ -40,7 +41,7 @@ const std::array<uint8_t, 4097> kLinearToSrgb = [] {
   std::array<uint8_t, 4097> t{};
   for (size_t i = 0; i < t.size(); ++i) {
     const double c = double(i) / 4096.0;
-    const double s = c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+    const double s = linear_to_srgb(c);
     t[i] = uint8_t(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
   }
   return t;

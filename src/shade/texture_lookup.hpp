@@ -110,11 +110,19 @@ inline Vec3 slot_data(const Scene& scene, const Hit& hit, const TextureSlot& slo
   return scene.textures[slot.texture].data(u, v, slot.sampler);
 }
 
-// The diffuse colour at a hit: the material's map_Kd (baseColorTexture), else Kd.
-// `cos_incidence`: |cos| of the ray with the surface.
+// The vertex colour at a hit (white where the scene has none).
+inline Vec3 vertex_color(const Scene& scene, const Hit& hit) {
+  if (scene.corner_colors.empty()) return Vec3{1.0f};
+  const Vec3* c = &scene.corner_colors[3 * size_t(hit.tri)];
+  return c[0] * (1.0f - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
+}
+
+// The diffuse colour at a hit: the material's map_Kd (baseColorTexture), else Kd, times the
+// vertex colour. `cos_incidence`: |cos| of the ray with the surface.
 inline Vec3 diffuse_color(const Scene& scene, const Hit& hit, const Material& mat, const RayCone& cone = {},
                           float cos_incidence = 1.0f) {
-  return slot_color(scene, hit, mat.diffuse_texture, mat.kd, cone, cos_incidence);
+  const Vec3 c = slot_color(scene, hit, mat.diffuse_texture, mat.kd, cone, cos_incidence);
+  return scene.corner_colors.empty() ? c : c * vertex_color(scene, hit);
 }
 
 }  // namespace tracer
