@@ -244,7 +244,7 @@ void write_gltf(const Scene& scene, const std::string& path, const GltfWriteOpti
     const double intensity = std::max({l.power.x, l.power.y, l.power.z});
     tg::Light light;
     light.type = "point";
-    light.intensity = intensity;
+    light.intensity = intensity * 683.0;  // candela: glTF's unit (gltf_viewpoints.cpp)
     light.color = {l.power.x / intensity, l.power.y / intensity, l.power.z / intensity};
     m.lights.push_back(light);
     tg::Node node;

@@ -16,6 +16,7 @@
 #include "importers/ply_loader.hpp"
 #include "importers/scene_file.hpp"
 #include "io/image_io.hpp"
+#include "render/lights.hpp"
 #include "scene_writers.hpp"
 #include "shade/material_bsdf.hpp"
 #include "shade/texture_lookup.hpp"
@@ -111,6 +112,68 @@ TEST(Gltf, VertexColoursMultiplyTheBaseColour) {
   EXPECT_EQ(gltf_load_error(coloured_gltf(R"("normalized": false)")),
             "t.gltf: mesh 0 'tri' primitive 0 COLOR_0 (accessor 2): not VEC3 or VEC4 of floats or normalised "
             "unsigned bytes or shorts");
+}
+
+// KHR_lights_punctual: a point, a spot and a directional light on child nodes of the triangle's,
+// the spot and the directional turned to shine down (-90 degrees about x takes -z to -y).
+TinyGltf lights_gltf(const std::string& spot_cone = R"("innerConeAngle": 0.2, "outerConeAngle": 0.5)") {
+  TinyGltf g;
+  g.extra = R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual": {"lights": [
+      {"type": "point", "color": [1, 0.5, 0.25], "intensity": 683},
+      {"type": "spot", "intensity": 1366, "spot": {)" +
+            spot_cone + R"(}},
+      {"type": "directional", "intensity": 68.3}]}}, )";
+  g.node = R"({"mesh": 0, "children": [1, 2, 3]})";
+  const std::string down = R"("rotation": [-0.70710678, 0, 0, 0.70710678])";
+  g.extra_nodes = R"(, {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+      {"translation": [0, 2, 0], )" +
+                  down + R"(, "extensions": {"KHR_lights_punctual": {"light": 1}}},
+      {)" + down + R"(, "extensions": {"KHR_lights_punctual": {"light": 2}}})";
+  return g;
+}
+
+TEST(Gltf, PointSpotAndDirectionalLightsInTracersUnits) {
+  const Scene s = load_gltf_from_memory(lights_gltf().json(), "t.gltf");
+  ASSERT_EQ(s.lights.size(), 3u);
+  // Candela and lux over 683 lm/W (Blender's importer's conversion).
+  EXPECT_EQ(s.lights[0].kind, LightKind::Point);
+  EXPECT_NEAR(s.lights[0].power.y, 0.5f, 1e-6f);
+  const Light& spot = s.lights[1];
+  EXPECT_EQ(spot.kind, LightKind::Spot);
+  EXPECT_NEAR(spot.power.x, 2.0f, 1e-6f);
+  EXPECT_NEAR(spot.normal.y, -1.0f, 1e-6f);
+  EXPECT_NEAR(spot.cos_inner, std::cos(0.2f), 1e-6f);
+  EXPECT_NEAR(spot.cos_outer, std::cos(0.5f), 1e-6f);
+  const Light& sun = s.lights[2];
+  EXPECT_EQ(sun.kind, LightKind::Directional);
+  EXPECT_NEAR(sun.power.z, 0.1f, 1e-6f);
+  EXPECT_NEAR(sun.normal.y, -1.0f, 1e-6f);
+  // What a point below sees: inside the inner cone all of the spot, between the cones the
+  // specification's smooth square ramp, outside nothing; the sun from straight above at any
+  // distance, and nothing on a surface facing away.
+  SurfaceInteraction si{};
+  si.n = si.shading_n = Vec3{0.0f, 1.0f, 0.0f};
+  si.geomID = si.inst = kInvalidIndex - 1;
+  LightSample ls;
+  ASSERT_TRUE(sample_lamp(spot, si, ls));
+  EXPECT_NEAR(ls.falloff, 1.0f / 4.0f, 1e-6f);
+  const float angle = 0.35f;  // between the cones
+  si.origin = Vec3{2.0f * std::tan(angle), 0.0f, 0.0f};
+  ASSERT_TRUE(sample_lamp(spot, si, ls));
+  const float t = (std::cos(angle) - std::cos(0.5f)) / (std::cos(0.2f) - std::cos(0.5f));
+  EXPECT_NEAR(ls.falloff, t * t * std::cos(angle) * std::cos(angle) / 4.0f, 1e-5f);
+  si.origin = Vec3{2.0f * std::tan(0.55f), 0.0f, 0.0f};
+  EXPECT_FALSE(sample_lamp(spot, si, ls));
+  ASSERT_TRUE(sample_lamp(sun, si, ls));
+  EXPECT_NEAR(ls.wi.y, 1.0f, 1e-6f);
+  EXPECT_EQ(ls.falloff, 1.0f);
+  EXPECT_EQ(ls.distance, kInfinity);
+  si.n = Vec3{0.0f, -1.0f, 0.0f};
+  EXPECT_FALSE(sample_lamp(sun, si, ls));
+  // Cone angles outside the specification's range are an error naming the light.
+  EXPECT_EQ(gltf_load_error(lights_gltf(R"("innerConeAngle": 0.5, "outerConeAngle": 0.5)").json()),
+            "t.gltf: light 1: spot cone angles inner 0.5, outer 0.5 (the specification's 0 <= inner < outer <= "
+            "pi/2)");
 }
 
 TEST(Gltf, NodeTransformsComposeAndAMirrorKeepsTheFrontFace) {

@@ -123,8 +123,14 @@ int cmd_info(const SceneArgs& args) {
   for (const std::string& m : scene.materials) std::printf(" %s", m.c_str());
   std::printf("\nlights      %" PRIu64 "\n", uint64_t(scene.lights.size()) + scene.unlisted_area_lights);
   for (const Light& l : scene.lights) {
-    std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", l.is_point() ? "point" : "area ", l.position.x,
-                l.position.y, l.position.z, l.power.x, l.power.y, l.power.z);
+    if (l.kind == LightKind::Directional) {
+      std::printf("  directional along (%g, %g, %g), irradiance (%g, %g, %g)\n", l.normal.x, l.normal.y, l.normal.z,
+                  l.power.x, l.power.y, l.power.z);
+      continue;
+    }
+    const char* kind = l.kind == LightKind::Point ? "point" : l.kind == LightKind::Spot ? "spot " : "area ";
+    std::printf("  %s at (%g, %g, %g), power (%g, %g, %g)\n", kind, l.position.x, l.position.y, l.position.z, l.power.x,
+                l.power.y, l.power.z);
   }
   if (scene.unlisted_area_lights) {
     std::printf("  area: %" PRIu64 " emissive primitives placed by the node tree\n", scene.unlisted_area_lights);

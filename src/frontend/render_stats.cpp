@@ -26,9 +26,14 @@ std::string lighting(const Scene& scene, const RenderSettings& settings, const R
   std::string out;
   const auto add = [&](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
   if (!scene.emitters.empty()) add(std::to_string(scene.emitters.size()) + " emissive triangles");
-  size_t points = 0;
-  for (const Light& l : scene.lights) points += l.is_point() ? 1 : 0;
-  if (points) add(std::to_string(points) + " point light" + (points > 1 ? "s" : ""));
+  const auto count = [&](LightKind kind, const char* name) {
+    size_t n = 0;
+    for (const Light& l : scene.lights) n += l.kind == kind ? 1 : 0;
+    if (n) add(std::to_string(n) + " " + name + (n > 1 ? "s" : ""));
+  };
+  count(LightKind::Point, "point light");
+  count(LightKind::Spot, "spot light");
+  count(LightKind::Directional, "directional light");
   if (settings.integrator == Integrator::Path || settings.integrator == Integrator::Whitted) {
     if (!scene.environment_map.empty()) add("an environment map");
     const Vec3 sky = settings.environment;

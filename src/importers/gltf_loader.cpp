@@ -48,7 +48,7 @@ constexpr int kMaxNodeDepth = 256;
 constexpr uint64_t kMaxSharedVisits = uint64_t(1) << 21;
 
 // The document's nodes walked from the chosen scene's roots: meshes placed by their transforms,
-// cameras and point lights; materials through gltf::Materials.
+// cameras and lights; materials through gltf::Materials.
 class GltfScene {
  public:
   GltfScene(const tg::Model& model, std::string name, fs::path base_dir, const LoadLimits& limits, CancelFlag cancel,
@@ -149,7 +149,7 @@ class GltfScene {
 
   // What tracer info prints, each node counted once however often it is reached: counts and
   // bounds from per-node sums (the bounds are those of the instances' boxes), and the world
-  // transform walked only down to the cameras and point lights that are listed.
+  // transform walked only down to the cameras and lights that are listed.
   SceneInfo summarize() {
     warn_unsupported();
     const std::vector<int> roots = root_nodes();
@@ -283,7 +283,7 @@ class GltfScene {
     return here;
   }
 
-  // The cameras and point lights below `index`, placed; subtrees without any are not entered.
+  // The cameras and lights below `index`, placed; subtrees without any are not entered.
   void visit_listed(int index, const Affine& parent, const std::vector<Summary>& sums, std::vector<char>& on_path,
                     int depth) {
     throw_if_cancelled(cancel_);
@@ -534,7 +534,7 @@ class GltfScene {
   }
 
   void add_light(const tg::Value& ext, const Affine& world) {
-    if (std::optional<Light> l = gltf::point_light_of(model_, name_, warnings_, ext, world)) scene_.lights.push_back(*l);
+    if (std::optional<Light> l = gltf::light_of(model_, name_, warnings_, ext, world)) scene_.lights.push_back(*l);
   }
 
   const tg::Model& model_;

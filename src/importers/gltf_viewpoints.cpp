@@ -41,25 +41,55 @@ std::optional<CameraSpec> camera_of(const tg::Model& model_, const std::string& 
   return spec;
 }
 
-std::optional<Light> point_light_of(const tg::Model& model_, const std::string& file, WarningLog& warnings_,
-                                    const tg::Value& ext, const Affine& world) {
+// glTF's lights are photometric (candela for point and spot lights, lux for directional ones),
+// tracer's radiometric: divided by 683 lm/W, as Blender's importer does (its default, "Standard"
+// conversion), so a glTF lamp lights a scene as brightly beside its emissive surfaces (whose
+// strength is radiance already) as in Blender and Cycles.
+constexpr double kLumensPerWatt = 683.0;
+
+std::optional<Light> light_of(const tg::Model& model_, const std::string& file, WarningLog& warnings_,
+                              const tg::Value& ext, const Affine& world) {
   const auto error = [&](const std::string& w) { return InputError(file + ": " + w); };
   const int index = int(gltf::number(&ext, "light", -1.0));
   if (index < 0 || size_t(index) >= model_.lights.size())
     throw error("light " + std::to_string(index) + " does not exist");
   const tg::Light& l = model_.lights[size_t(index)];
-  if (l.type != "point") {
-    warnings_.add("light " + std::to_string(index) + " is a " + in_quotes(l.type) +
-                  " light: only point lights are used");
+  const std::string what = "light " + std::to_string(index);
+  Light light;
+  if (l.type == "point") {
+    light.kind = LightKind::Point;
+  } else if (l.type == "spot") {
+    light.kind = LightKind::Spot;
+  } else if (l.type == "directional") {
+    light.kind = LightKind::Directional;
+  } else {
+    warnings_.add(what + " is of unknown type " + in_quotes(l.type) + ": not used");
     return std::nullopt;
   }
-  Light light;
+  if (l.range > 0.0 && light.kind != LightKind::Directional) {
+    warnings_.add("a light's range not used: lights fall off with the inverse square of distance only");
+  }
   light.position = world.point(Vec3{0.0f});
-  light.power = gltf::vec3_of(l.color, Vec3{1.0f}) * float(l.intensity);
+  if (light.kind != LightKind::Point) {
+    const Vec3 axis = world.vector(Vec3{0.0f, 0.0f, -1.0f});  // the node's -z
+    const float len = length(axis);
+    if (!(len > 0.0f) || !std::isfinite(len)) throw error(what + ": its node's transform leaves no direction");
+    light.normal = axis / len;
+  }
+  if (light.kind == LightKind::Spot) {
+    const double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
+    if (!(inner >= 0.0) || !(outer > inner) || !(outer <= std::numbers::pi / 2 + 1e-9)) {
+      throw error(what + ": spot cone angles inner " + format_number(inner) + ", outer " + format_number(outer) +
+                  " (the specification's 0 <= inner < outer <= pi/2)");
+    }
+    light.cos_inner = float(std::cos(inner));
+    light.cos_outer = float(std::cos(outer));
+  }
+  light.power = gltf::vec3_of(l.color, Vec3{1.0f}) * float(l.intensity / kLumensPerWatt);
   if (!is_finite(light.position) || !is_finite(light.power) || light.power.x < 0.0f || light.power.y < 0.0f ||
       light.power.z < 0.0f || max_component(light.power) > kMaxLightIntensity) {
-    throw error("light " + std::to_string(index) + ": position or intensity not finite, negative or above " +
-                format_number(kMaxLightIntensity) + " (--light-intensity's limit)");
+    throw error(what + ": position or intensity not finite, negative or above " + format_number(kMaxLightIntensity) +
+                " (--light-intensity's limit)");
   }
   return light;
 }

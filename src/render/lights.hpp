@@ -29,11 +29,21 @@ struct LightSample {
   float distance = kInfinity;  // the shadow ray's tfar: short of the light's own surface
 };
 
-// The lamp `light` seen from `si`: toward its position (a point light) or the centroid of its area
-// (the study's one shadow ray per area light); false when it cannot light `si` (it is the
-// surface's own emitter, or lies behind the surface).
+// The lamp `light` seen from `si`: toward its position (a point or spot light), against its
+// direction (a directional light), or toward the centroid of its area (the study's one shadow ray
+// per area light); false when it cannot light `si` (it is the surface's own emitter, lies behind
+// the surface, or `si` is outside a spot's cone).
 inline bool sample_lamp(const Light& light, const SurfaceInteraction& si, LightSample& out) {
   if (light.geomID == si.geomID && light.inst == si.inst) return false;  // an emitter does not light itself
+  if (light.kind == LightKind::Directional) {
+    out.wi = -light.normal;
+    if (dot(si.n, out.wi) <= 0.0f) return false;
+    out.L = light.power;
+    out.falloff = 1.0f;  // irradiance at normal incidence, at every distance
+    out.pdf = 1.0f;
+    out.distance = kInfinity;
+    return true;
+  }
   const Vec3 to_light = light.position - si.origin;
   const float d2 = dot(to_light, to_light);
   if (!(d2 > 0.0f)) return false;
@@ -42,7 +52,10 @@ inline bool sample_lamp(const Light& light, const SurfaceInteraction& si, LightS
   if (dot(si.n, wi) <= 0.0f) return false;  // below the surface itself, whatever the shading normal
   // Irradiance from a light of area A at distance d: power * cos_l / (d^2 + A/pi), exact on the
   // axis of a disk of that area and free of the 1/d^2 blow-up near the lamp; 1/d^2 for points.
-  const float cos_light = light.is_point() ? 1.0f : std::fabs(dot(light.normal, wi));
+  const float cos_light = light.kind == LightKind::Area   ? std::fabs(dot(light.normal, wi))
+                          : light.kind == LightKind::Spot ? light.spot_falloff(-dot(light.normal, wi))
+                                                          : 1.0f;
+  if (light.kind == LightKind::Spot && !(cos_light > 0.0f)) return false;  // outside its cone
   out.L = light.power;
   out.wi = wi;
   out.falloff = cos_light / (d2 + light.area * std::numbers::inv_pi_v<float>);
@@ -125,8 +138,8 @@ class LightSampler {
   float pdf_emitter(uint32_t tri, uint32_t inst, Vec3 from, Vec3 to) const {
     return (1.0f - p_env_) * scene_->emitters.pdf(*scene_, tri, inst, from, to);
   }
-  // The scene's lamps: path tracing takes the point lights among them at every vertex (an area
-  // lamp's triangles are sample()'s emitters).
+  // The scene's lamps: path tracing takes the point, spot and directional lights among them at
+  // every vertex (an area lamp's triangles are sample()'s emitters).
   std::span<const Light> lamps() const { return scene_->lights; }
 
  private:

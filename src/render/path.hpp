@@ -72,7 +72,7 @@ void add_sampled_light(const Accel& accel, const LightSampler& lights, const Sur
     }
   }
   for (const Light& lamp : lights.lamps()) {
-    if (!lamp.is_point() || !sample_lamp(lamp, si, ls)) continue;
+    if (!lamp.is_delta() || !sample_lamp(lamp, si, ls)) continue;
     const Vec3 f = bsdf.eval(wo, ls.wi);
     if (!(max_component(f) > 0.0f)) continue;
     radiance += direct_light(accel, si, ls, beta * f, 1.0f, counts);

@@ -95,7 +95,7 @@ void Scene::finalize() {
   }
   // One area light per (geometry, emissive material) and instance: the Cornell lamp is one quad,
   // one light.
-  std::erase_if(lights, [](const Light& l) { return !l.is_point(); });
+  std::erase_if(lights, [](const Light& l) { return l.kind == LightKind::Area; });
   // A light's power is its emission times its area; with an emission texture, the sum of its
   // triangles' mean emission times area, and its position their centroids weighted by that.
   struct Accum {
@@ -129,6 +129,7 @@ void Scene::finalize() {
     for (const auto& [key, a] : by_source) {
       if (a.area <= 0.0f || (a.textured && !(a.luminance > 0.0f))) continue;  // no area, or black texels only
       Light l;
+      l.kind = LightKind::Area;
       l.position = a.textured ? a.power_centroid / a.luminance : a.weighted_centroid / a.area;
       const float n_len = length(a.normal);
       l.normal = n_len > 0.0f ? a.normal / n_len : Vec3{0.0f, -1.0f, 0.0f};

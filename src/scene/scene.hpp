@@ -2,6 +2,7 @@
 // an optional camera the scene suggests.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -93,14 +94,33 @@ struct Material {
 
 // An area light is approximated by its area-weighted centroid (one shadow ray per light, as in the
 // study); `power` is Ke times area. A point light has a zero normal and `power` is its intensity.
+// A lamp: a point light (--light, glTF's point), a spot (glTF's: a point whose intensity falls
+// off between two cones about `normal`), a directional light (glTF's: parallel light travelling
+// along `normal` from beyond the scene), or an area light's centroid (an emissive surface, for
+// the study's one shadow ray per light; path tracing samples its triangles instead).
+enum class LightKind : uint8_t { Point, Spot, Directional, Area };
+
 struct Light {
   Vec3 position;
-  Vec3 normal;
-  Vec3 power;
-  float area = 0.0f;                // emitting area (0 for point lights)
-  uint32_t geomID = kInvalidIndex;  // the emitting geometry, or kInvalidIndex for point lights
+  Vec3 normal;        // area: the emitting side's normal; spot: the cone's axis; directional: where the light travels
+  Vec3 power;         // point, spot: radiant intensity (W/sr); directional: irradiance (W/m^2); area: Ke x area
+  float area = 0.0f;  // emitting area (area lights)
+  float cos_outer = 0.0f;           // spot: the cosines of its outer and inner cone half-angles
+  float cos_inner = 1.0f;           //
+  uint32_t geomID = kInvalidIndex;  // the emitting geometry, or kInvalidIndex for a lamp of no surface
   uint32_t inst = kInvalidIndex;    // the instance placing it (instanced scenes)
-  bool is_point() const { return normal == Vec3{0.0f}; }
+  LightKind kind = LightKind::Point;
+  bool is_point() const { return kind == LightKind::Point; }
+  // A point, spot or directional light: one direction from each shading point, which only
+  // next-event estimation finds (no ray hits it).
+  bool is_delta() const { return kind != LightKind::Area; }
+  // glTF's spot falloff (KHR_lights_punctual): a smooth square ramp in the cosine between the two
+  // cones, for `cos_axis` the cosine between the axis and the direction to the lit point.
+  float spot_falloff(float cos_axis) const {
+    const float scale = 1.0f / std::max(1e-3f, cos_inner - cos_outer);
+    const float t = std::clamp((cos_axis - cos_outer) * scale, 0.0f, 1.0f);
+    return t * t;
+  }
 };
 
 // One OBJ group/object: geomID is its index, primID counts triangles from `first_triangle`.

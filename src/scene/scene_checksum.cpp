@@ -87,6 +87,11 @@ uint64_t scene_checksum(const Scene& scene) {
   for (const Light& l : scene.lights) {
     for (const Vec3& c : {l.position, l.normal, l.power}) h.value(c);
     h.value(l.area);
+    if (l.kind == LightKind::Spot || l.kind == LightKind::Directional) {  // point and area keep their checksums
+      h.value(l.kind);
+      h.value(l.cos_outer);
+      h.value(l.cos_inner);
+    }
   }
   if (scene.instanced()) {  // flat scenes keep the checksums they had
     h.value(uint64_t(scene.meshes.size()));
