@@ -245,13 +245,15 @@ TEST(Bsdf, MaterialsMapToTheirLobes) {
   Material m;
   m.illum = 5;
   m.ks = Vec3{0.9f};
-  EXPECT_EQ(material_bsdf(m, MaterialPoint{.color = m.kd}, Vec3{0, 0, 1}, true).kind(), Bsdf::Kind::Mirror);
+  EXPECT_EQ(material_bsdf(m, MaterialPoint{.color = m.kd, .specular = m.ks}, Vec3{0, 0, 1}, true).kind(),
+            Bsdf::Kind::Mirror);
   m.illum = 7;
   m.ni = 1.33f;
   EXPECT_EQ(material_bsdf(m, MaterialPoint{.color = m.kd}, Vec3{0, 0, 1}, true).kind(), Bsdf::Kind::Dielectric);
   m.illum = 2;
   m.ns = 100.0f;
-  const Bsdf b = material_bsdf(m, MaterialPoint{.color = Vec3{0.5f}}, Vec3{0, 0, 1}, true);
+  const Bsdf b =
+      material_bsdf(m, MaterialPoint{.color = Vec3{0.5f}, .specular = m.ks, .shininess = m.ns}, Vec3{0, 0, 1}, true);
   EXPECT_EQ(b.kind(), Bsdf::Kind::Smooth);
   // Kd + Ks = 1.4 is scaled to 1: the white furnace holds for any MTL values.
   std::mt19937 gen(9);

@@ -4,6 +4,7 @@
 #include <stb_image_write.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -13,7 +14,9 @@
 #include "io/exr_io.hpp"
 #include "parallel/executor.hpp"
 #include "render/render_image.hpp"
+#include "scene/emission.hpp"
 #include "scene/texture.hpp"
+#include "shade/material_bsdf.hpp"
 #include "test_util.hpp"
 
 namespace tracer {
@@ -97,6 +100,57 @@ TEST(Texture, MissingTextureWarnsOnceAndUsesKd) {
   EXPECT_TRUE(scene.textures.empty());
   EXPECT_FALSE(scene.materials[0].diffuse_texture.present());
   EXPECT_EQ(scene.materials[0].kd, (Vec3{0.1f, 0.2f, 0.3f}));
+}
+
+// map_Ks, map_Ns, map_Ke and norm, each a one-texel PNG: the specular colour is Ks times the
+// texel, the shininess Ns times the texel as data, the emission Ke times the texel (Ke 1 where
+// the MTL gives none), and norm the normal map; a missing one is its own grouped warning.
+TEST(Texture, MtlMapsScaleTheirValues) {
+  const std::string dir = test::temp_dir();
+  const auto png = [&](const std::string& file, std::vector<uint8_t> rgb) {
+    ASSERT_TRUE(stbi_write_png((dir + "/" + file).c_str(), 1, 1, 3, rgb.data(), 3));
+  };
+  png("ks.png", {255, 128, 0});
+  png("ns.png", {51, 102, 153});  // as data: the mean 0.4
+  png("ke.png", {0, 255, 128});
+  png("n.png", {128, 128, 255});
+  std::ofstream(dir + "/quad.obj") << "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n"
+                                      "usemtl lamp\nf 1/1 3/3 4/4\nusemtl lost\nf 1/1 2/2 3/3\n";
+  std::ofstream(dir + "/quad.mtl") << "newmtl m\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 100\nillum 2\nmap_Ks ks.png\n"
+                                      "map_Ns ns.png\nnorm -bm 0.5 n.png\nnewmtl lamp\nmap_Ke ke.png\n"
+                                      "newmtl lost\nmap_Ks gone.png\n";
+  std::vector<std::string> warnings;
+  const Scene scene = load_obj(dir + "/quad.obj", [&](const std::string& w) { warnings.push_back(w); });
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("1 map_Ks texture(s) not used (first 'gone.png': not found); those materials use Ks"),
+            std::string::npos)
+      << warnings[0];
+  const Material& m = scene.materials[0];
+  ASSERT_TRUE(m.specular_texture.present() && m.shininess_texture.present() && m.normal_texture.present());
+  EXPECT_EQ(m.normal_scale, 0.5f);
+  Hit hit;
+  hit.tri = 0;
+  hit.u = hit.v = 0.3f;
+  const MaterialPoint p = material_point(scene, hit, m);
+  EXPECT_NEAR(p.specular.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(p.specular.y, 0.5f * srgb_to_linear(uint8_t(128)), 1e-6f);
+  EXPECT_EQ(p.specular.z, 0.0f);
+  EXPECT_NEAR(p.shininess, 40.0f, 1e-3f);
+  const Material& lamp = scene.materials[1];
+  EXPECT_EQ(lamp.ke, Vec3{1.0f});
+  const Vec3 e = emitted_radiance(scene, 2, 0.3f, 0.3f);
+  EXPECT_EQ(e.x, 0.0f);
+  EXPECT_NEAR(e.y, 1.0f, 1e-6f);
+  EXPECT_NEAR(e.z, srgb_to_linear(uint8_t(128)), 1e-6f);
+  EXPECT_EQ(scene.emitters.size(), 1u);  // the lamp's triangle
+  // Without the maps the same material is its plain values, bit for bit (OBJ images unchanged).
+  Material plain = m;
+  plain.specular_texture = plain.shininess_texture = TextureSlot{};
+  const MaterialPoint q = material_point(scene, hit, plain);
+  EXPECT_EQ(q.specular, m.ks);
+  EXPECT_EQ(q.shininess, m.ns);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Texture, UnreadableTextureWarnsWithTheReason) {

@@ -183,8 +183,9 @@ class Statement {
 };
 
 bool is_known(std::string_view k) {
-  static constexpr std::string_view kKnown[] = {"Ka", "Kd", "Ks",    "Ke",     "Tf",       "Kt",       "Ns",  "Ni",
-                                                "d",  "Tr", "illum", "map_Kd", "map_bump", "map_Bump", "bump"};
+  static constexpr std::string_view kKnown[] = {"Ka",   "Kd",     "Ks",     "Ke",     "Tf",     "Kt",       "Ns",
+                                                "Ni",   "d",      "Tr",     "illum",  "map_Kd", "map_bump", "map_Bump",
+                                                "bump", "map_Ks", "map_Ns", "map_Ke", "norm"};
   for (std::string_view known : kKnown) {
     if (k == known) return true;
   }
@@ -245,6 +246,14 @@ MtlFile parse_mtl(std::string_view text, const std::string& name, CancelFlag can
       if (!has_kd) m->kd = Vec3{0.6f};
     } else if (keyword == "map_bump" || keyword == "map_Bump" || keyword == "bump") {
       m->bump_map = st.texture(&m->bump_multiplier, unknown_options);
+    } else if (keyword == "map_Ks") {
+      m->specular_map = st.texture(nullptr, unknown_options);
+    } else if (keyword == "map_Ns") {
+      m->shininess_map = st.texture(nullptr, unknown_options);
+    } else if (keyword == "map_Ke") {
+      m->emissive_map = st.texture(nullptr, unknown_options);
+    } else if (keyword == "norm") {
+      m->normal_map = st.texture(&m->normal_scale, unknown_options);
     } else if (keyword == "Ns") {
       m->ns = st.number(0.0f, kMaxShininess);
     } else if (keyword == "Ni") {

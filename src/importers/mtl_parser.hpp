@@ -29,6 +29,11 @@ struct MtlMaterial {
   std::string diffuse_map;       // map_Kd's file name, its options dropped
   std::string bump_map;          // map_bump / bump
   float bump_multiplier = 1.0f;  // its -bm
+  std::string specular_map;      // map_Ks: scales Ks
+  std::string shininess_map;     // map_Ns: scales Ns
+  std::string emissive_map;      // map_Ke: scales Ke
+  std::string normal_map;        // norm: a tangent-space normal map (the PBR extension's)
+  float normal_scale = 1.0f;     // its -bm
   size_t line = 0;               // where `newmtl` stands
 };
 
@@ -39,7 +44,7 @@ struct MtlFile {
 };
 
 // Parses MTL text; `name` stands for the file in messages. Throws InputError("name:line: ...").
-// Statements the renderer does not use (map_Ks, Pr, ...) are skipped; a spectral colour
+// Statements the renderer does not use (map_Ka, Pr, ...) are skipped; a spectral colour
 // (`Kd spectral file.rfl`) is an error, as tracer renders RGB.
 MtlFile parse_mtl(std::string_view text, const std::string& name, CancelFlag cancel = nullptr);
 

@@ -23,14 +23,30 @@
 namespace tracer {
 namespace {
 
-// Two names per material, in material order: its map_Kd, its map_bump ("" where none).
+// The MTL maps tracer reads: which statement, its file name in MtlMaterial, the slot it fills and
+// what a material whose file cannot be used does instead.
+struct MtlMap {
+  const char* keyword;
+  std::string MtlMaterial::*file;
+  TextureSlot Material::*slot;
+  const char* otherwise;
+};
+const MtlMap kMtlMaps[] = {
+    {"map_Kd", &MtlMaterial::diffuse_map, &Material::diffuse_texture, "those materials use Kd"},
+    {"map_bump", &MtlMaterial::bump_map, &Material::bump_texture, "those materials are flat"},
+    {"map_Ks", &MtlMaterial::specular_map, &Material::specular_texture, "those materials use Ks"},
+    {"map_Ns", &MtlMaterial::shininess_map, &Material::shininess_texture, "those materials use Ns"},
+    {"map_Ke", &MtlMaterial::emissive_map, &Material::emission_texture, "those materials use Ke"},
+    {"norm", &MtlMaterial::normal_map, &Material::normal_texture, "those materials are flat"},
+};
+constexpr size_t kMapCount = std::size(kMtlMaps);
+
+// kMapCount names per material, in material order, each map's ("" where none).
 std::vector<std::string> texture_names(const std::vector<MtlMaterial>& materials) {
   std::vector<std::string> names;
-  names.reserve(2 * materials.size());
-  for (const MtlMaterial& m : materials) {
-    names.push_back(m.diffuse_map);
-    names.push_back(m.bump_map);
-  }
+  names.reserve(kMapCount * materials.size());
+  for (const MtlMaterial& m : materials)
+    for (const MtlMap& map : kMtlMaps) names.push_back(m.*map.file);
   return names;
 }
 
@@ -161,8 +177,8 @@ Material to_material(const MtlMaterial& m, const std::string& name) {
   return mat;
 }
 
-// The map_Kd and map_bump textures of a list of materials (texture_names()), each file read and
-// decoded once. The other maps (Ks, Ka, alpha) are not used by any integrator, so not read.
+// The textures of a list of materials (texture_names(): kMtlMaps), each file read and decoded
+// once. The other maps (map_Ka, map_d, the PBR extension's) are not read.
 struct MaterialTextures {
   std::vector<std::string> texnames;            // what this was made for
   std::vector<std::string> problem;             // per material: why its texture is not used
@@ -291,31 +307,30 @@ void add_materials(Scene& scene, const Layout& layout, MaterialTextures textures
     scene.textures.push_back(std::move(*textures.decoded[k]));
   }
   const std::vector<std::string>& problem = textures.problem;  // per texture name
-  size_t missing[2] = {0, 0};                                  // map_Kd, map_bump
-  std::string first_missing[2];
+  size_t missing[kMapCount] = {};
+  std::string first_missing[kMapCount];
   for (size_t i = 0; i < layout.materials.size(); ++i) {
     const MtlMaterial& m = layout.materials[i];
     Material mat = to_material(m, name);
-    uint32_t* slot[2] = {&mat.diffuse_texture.texture, &mat.bump_texture.texture};
-    const std::string* map[2] = {&m.diffuse_map, &m.bump_map};
-    for (size_t k = 0; k < 2; ++k) {
-      std::string why = problem[2 * i + k];
-      if (const uint32_t file = textures.file_of[2 * i + k]; file != kInvalidIndex) {
-        *slot[k] = texture_of[file];
-        if (*slot[k] == kInvalidIndex) why = textures.file_problem[file];
+    for (size_t k = 0; k < kMapCount; ++k) {
+      std::string why = problem[kMapCount * i + k];
+      uint32_t& slot = (mat.*kMtlMaps[k].slot).texture;
+      if (const uint32_t file = textures.file_of[kMapCount * i + k]; file != kInvalidIndex) {
+        slot = texture_of[file];
+        if (slot == kInvalidIndex) why = textures.file_problem[file];
       }
-      if (!why.empty() && missing[k]++ == 0) first_missing[k] = in_quotes(*map[k]) + ": " + why;
+      if (!why.empty() && missing[k]++ == 0) first_missing[k] = in_quotes(m.*kMtlMaps[k].file) + ": " + why;
     }
     mat.bump_multiplier = m.bump_multiplier;
+    mat.normal_scale = m.normal_scale;
+    // map_Ke without Ke: the texture is the emission (as map_Kd without Kd shows its texture).
+    if (mat.emission_texture.present() && !mat.emissive()) mat.ke = Vec3{1.0f};
     scene.materials.push_back(std::move(mat));
   }
-  if (missing[0] > 0) {
-    warnings.add(std::to_string(missing[0]) + " map_Kd texture(s) not used (first " + first_missing[0] +
-                 "); those materials use Kd");
-  }
-  if (missing[1] > 0) {
-    warnings.add(std::to_string(missing[1]) + " map_bump texture(s) not used (first " + first_missing[1] +
-                 "); those materials are flat");
+  for (size_t k = 0; k < kMapCount; ++k) {
+    if (missing[k] == 0) continue;
+    warnings.add(std::to_string(missing[k]) + " " + kMtlMaps[k].keyword + " texture(s) not used (first " +
+                 first_missing[k] + "); " + kMtlMaps[k].otherwise);
   }
   if (layout.uses_default) scene.materials.push_back(Material{});
 }

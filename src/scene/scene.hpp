@@ -72,14 +72,18 @@ struct Material {
   float specular_f90 = 1.0f;
   // glTF's metallicRoughnessTexture: its blue channel scales `metallic`, its green `roughness`.
   TextureSlot metallic_roughness_texture;
-  // glTF's emissiveTexture: the emission `ke` times its texel (scene/emission.hpp).
+  // glTF's emissiveTexture, MTL's map_Ke: the emission `ke` times its texel (scene/emission.hpp).
   TextureSlot emission_texture;
+  // MTL's map_Ks (its texel times Ks) and map_Ns (the mean of its channels, as data, times Ns).
+  TextureSlot specular_texture, shininess_texture;
   // Every slot, for what treats them alike (the importers' index remapping and checks).
-  std::array<TextureSlot*, 5> slots() {
-    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture, &emission_texture};
+  std::array<TextureSlot*, 7> slots() {
+    return {&diffuse_texture,  &bump_texture,     &normal_texture,   &metallic_roughness_texture,
+            &emission_texture, &specular_texture, &shininess_texture};
   }
-  std::array<const TextureSlot*, 5> slots() const {
-    return {&diffuse_texture, &bump_texture, &normal_texture, &metallic_roughness_texture, &emission_texture};
+  std::array<const TextureSlot*, 7> slots() const {
+    return {&diffuse_texture,  &bump_texture,     &normal_texture,   &metallic_roughness_texture,
+            &emission_texture, &specular_texture, &shininess_texture};
   }
   bool emissive() const { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
   // illum 3 and 5 (ray-traced reflection) are mirrors weighted by Ks; 4, 6, 7 and 9 (ray-traced

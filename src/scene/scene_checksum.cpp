@@ -75,7 +75,8 @@ uint64_t scene_checksum(const Scene& scene) {
       h.value(m.specular_f90);
       slot(m.metallic_roughness_texture);
     }
-    if (m.emission_texture.present()) slot(m.emission_texture);  // likewise
+    for (const TextureSlot* t : {&m.emission_texture, &m.specular_texture, &m.shininess_texture})
+      if (t->present()) slot(*t);  // likewise
   }
   h.value(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {

@@ -17,6 +17,8 @@ namespace tracer {
 struct MaterialPoint {
   Vec3 color{0.0f};  // Kd or the base colour (map_Kd, baseColorTexture)
   float metallic = 0.0f, roughness = 1.0f;
+  Vec3 specular{0.0f};     // MTL: Ks (times map_Ks)
+  float shininess = 0.0f;  // MTL: Ns (times map_Ns)
   // What the surface reflects of uniform light, within [0, 1]: the denoiser's albedo feature and
   // the diffuse shade of whitted's lamp light. MTL: Kd + Ks; metallic-roughness: the diffuse under
   // the specular layer plus that layer's reflectance at normal incidence.
@@ -29,7 +31,13 @@ inline MaterialPoint material_point(const Scene& scene, const Hit& hit, const Ma
   MaterialPoint p;
   p.color = diffuse_color(scene, hit, mat, cone, cos_incidence);
   if (!mat.metallic_roughness) {
-    p.albedo = min(p.color + mat.ks, Vec3{1.0f});
+    p.specular = slot_color(scene, hit, mat.specular_texture, Vec3{1.0f}, cone, cos_incidence) * mat.ks;
+    p.shininess = mat.ns;
+    if (mat.shininess_texture.present()) {
+      const Vec3 t = slot_data(scene, hit, mat.shininess_texture, Vec3{1.0f});
+      p.shininess *= (t.x + t.y + t.z) * (1.0f / 3.0f);
+    }
+    p.albedo = min(p.color + p.specular, Vec3{1.0f});
     return p;
   }
   const Vec3 mr = slot_data(scene, hit, mat.metallic_roughness_texture, Vec3{1.0f});
@@ -47,7 +55,7 @@ inline Bsdf material_bsdf(const Material& mat, const MaterialPoint& p, Vec3 shad
   const Frame frame(shading_n);
   switch (mat.surface()) {
     case SurfaceKind::Mirror:
-      return Bsdf::mirror(frame, mat.ks);
+      return Bsdf::mirror(frame, p.specular);
     case SurfaceKind::Dielectric:
       return Bsdf::dielectric(frame, front ? mat.ni : 1.0f / mat.ni, mat.tf);
     case SurfaceKind::MetallicRoughness:  // GGX's alpha is roughness squared (glTF)
@@ -56,7 +64,7 @@ inline Bsdf material_bsdf(const Material& mat, const MaterialPoint& p, Vec3 shad
     case SurfaceKind::Diffuse:
       break;
   }
-  return Bsdf::smooth(frame, p.color, mat.illum >= 2 ? mat.ks : Vec3{0.0f}, Ggx::from_phong_exponent(mat.ns));
+  return Bsdf::smooth(frame, p.color, mat.illum >= 2 ? p.specular : Vec3{0.0f}, Ggx::from_phong_exponent(p.shininess));
 }
 
 }  // namespace tracer

@@ -41,7 +41,10 @@ bool is_colour(const std::string& k) {
   return k == "Ka" || k == "Kd" || k == "Ks" || k == "Ke" || k == "Tf" || k == "Kt";
 }
 
-bool is_map(const std::string& k) { return k == "map_Kd" || k == "map_bump" || k == "map_Bump" || k == "bump"; }
+bool is_map(const std::string& k) {
+  return k == "map_Kd" || k == "map_bump" || k == "map_Bump" || k == "bump" || k == "map_Ks" || k == "map_Ns" ||
+         k == "map_Ke" || k == "norm";
+}
 
 // A texture statement with every option's values written out: `-o`, `-s`, `-t` take one to three
 // numbers and `-mm` one or two (tinyobjloader always takes three and two, the file name among
@@ -185,8 +188,15 @@ std::optional<std::string> mtl_disagreement(const std::string& text, bool* refus
     }
     if (a.diffuse_map != b.diffuse_texname)
       return at + "map_Kd '" + a.diffuse_map + "', tinyobjloader '" + b.diffuse_texname + "'";
-    if (a.bump_map != b.bump_texname)
-      return at + "map_bump '" + a.bump_map + "', tinyobjloader '" + b.bump_texname + "'";
+    const std::pair<const char*, std::pair<const std::string*, const std::string*>> maps[] = {
+        {"map_bump", {&a.bump_map, &b.bump_texname}},
+        {"map_Ks", {&a.specular_map, &b.specular_texname}},
+        {"map_Ns", {&a.shininess_map, &b.specular_highlight_texname}},
+        {"map_Ke", {&a.emissive_map, &b.emissive_texname}},
+        {"norm", {&a.normal_map, &b.normal_texname}}};
+    for (const auto& [key, pair] : maps) {
+      if (*pair.first != *pair.second) return at + key + " '" + *pair.first + "', tinyobjloader '" + *pair.second + "'";
+    }
   }
   return std::nullopt;
 }
